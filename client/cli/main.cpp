@@ -1,0 +1,29 @@
+// surfinspect: command-line front end. Runs each step in-process; with
+// --server (added per command by later steps) it calls surfinspectd.
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include "client/cli/commands.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"surfinspect: point-cloud filtering, calibration, registration and "
+               "error maps against CAD (units: mm)"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "surfinspect 0.1.0");
+  // Logs and errors go to stderr so stdout stays clean for piping results.
+  spdlog::set_default_logger(spdlog::stderr_color_mt("surfinspect"));
+  spdlog::set_pattern("%^%l%$: %v");
+  surfinspect::cli::AddInfoCommand(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const surfinspect::cli::CommandFailed& e) {
+    spdlog::error("{}", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    spdlog::error("unexpected: {}", e.what());
+    return 2;
+  }
+  return 0;
+}
