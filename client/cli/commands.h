@@ -26,5 +26,6 @@ T Take(absl::StatusOr<T> v) {
 }
 
 void AddInfoCommand(CLI::App& app);
+void AddFilterCommand(CLI::App& app);
 
 }  // namespace surfinspect::cli
