@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   spdlog::set_pattern("%^%l%$: %v");
   surfinspect::cli::AddInfoCommand(app);
   surfinspect::cli::AddFilterCommand(app);
+  surfinspect::cli::AddSimulateCommands(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
