@@ -26,5 +26,7 @@ T Take(absl::StatusOr<T> v) {
 }
 
 void AddInfoCommand(CLI::App& app);
+void AddFilterCommand(CLI::App& app);
+void AddSimulateCommands(CLI::App& app);
 
 }  // namespace surfinspect::cli

@@ -14,6 +14,8 @@ int main(int argc, char** argv) {
   spdlog::set_default_logger(spdlog::stderr_color_mt("surfinspect"));
   spdlog::set_pattern("%^%l%$: %v");
   surfinspect::cli::AddInfoCommand(app);
+  surfinspect::cli::AddFilterCommand(app);
+  surfinspect::cli::AddSimulateCommands(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

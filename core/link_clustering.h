@@ -1,0 +1,123 @@
+// Link clustering (paper §III): split a cloud into connected components
+// where two points are "linked" when their 3D Euclidean distance is at most
+// `link_distance_mm`, then call every small component an outlier. This
+// removes pulses (isolated points) and stripes (short chains at the edges of
+// shadows) while keeping dents and dints, which stay linked to the surface
+// around them. No coordinate is ever modified: the filter only removes.
+//
+// Two paths with the same semantics for "linked":
+//  * organized grid (the fast path for sensor data): only 4- or 8-neighbours
+//    in the sensor grid may link; a two-pass union-find over the grid
+//    (Wu, Otoo & Suzuki, "Optimizing two-pass connected-component labeling
+//    algorithms", 2009) with the parent forest stored in the label array;
+//  * unorganized (the general path): every pair within the link distance
+//    links, found with a hashed voxel grid whose cell edge equals the link
+//    distance (27 neighbouring cells), see link_clustering_unorganized.h.
+#pragma once
+
+#include <Eigen/Core>
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "core/point_cloud.h"
+
+namespace surfinspect {
+
+struct LinkClusteringSettings {
+  // Two points link when |p - q| <= link_distance_mm (mm, finite, > 0). The
+  // paper uses 0.1-0.5 mm "according to the resolution of area sensors".
+  double link_distance_mm = 0.5;
+  // Components with fewer valid points than this are outliers. The paper
+  // uses the class size as the criterion; 50 points is ~3 mm^2 of surface
+  // at the demo sensor's ~0.25 mm pixel pitch, far above pulse and stripe
+  // sizes and far below any real surface patch.
+  uint32_t min_cluster_points = 50;
+  // Grid path only: 4 or 8 neighbours.
+  int connectivity = 8;
+  // Also an outlier: a component with fewer than this fraction of the
+  // largest component's points. In [0, 1]; 0 = off.
+  double min_fraction_of_largest = 0.0;
+};
+
+struct ClusterInfo {
+  uint32_t size = 0;  // valid points in the component
+  // Grid bounding box, inclusive (organized). For an unorganized cloud the
+  // rows are 0 and the columns are the smallest and largest point index.
+  uint32_t min_row = 0, min_col = 0, max_row = 0, max_col = 0;
+  Eigen::Vector3f min{Eigen::Vector3f::Zero()};  // 3D bounding box, mm,
+  Eigen::Vector3f max{Eigen::Vector3f::Zero()};  //   frame of the cloud
+  bool kept = false;
+};
+
+struct LinkClusteringResult {
+  // Per point: component id in [0, clusters.size()), or kInvalid for a point
+  // without data. Ids are numbered in order of each component's first point.
+  static constexpr int32_t kInvalid = -1;
+  std::vector<int32_t> labels;
+  std::vector<ClusterInfo> clusters;
+  std::vector<uint8_t> kept_mask;  // per point: 1 = kept, 0 = removed or no data
+  std::size_t input_points = 0;    // width * height
+  std::size_t valid_points = 0;
+  std::size_t kept = 0;
+  std::size_t removed = 0;         // valid points in outlier components
+  uint32_t largest_cluster = 0;    // size of the largest component (0 if none)
+  bool organized_path = false;     // which path produced this
+};
+
+// The link predicate both paths (and their tests) use, in float arithmetic
+// with a fixed summation order so every path decides identically. False
+// when either point holds NaN.
+inline bool PointsLinked(const Eigen::Vector3f& a, const Eigen::Vector3f& b,
+                         float link_distance_sq) {
+  const float dx = a.x() - b.x(), dy = a.y() - b.y(), dz = a.z() - b.z();
+  return dx * dx + dy * dy + dz * dz <= link_distance_sq;
+}
+// The squared link distance as the paths compare it.
+inline float LinkDistanceSquared(double link_distance_mm) {
+  return static_cast<float>(link_distance_mm * link_distance_mm);
+}
+
+// Checks the settings: InvalidArgument naming the bad field.
+absl::Status ValidateLinkClusteringSettings(const LinkClusteringSettings& settings);
+
+// Organized cloud (height > 1) -> grid path, otherwise the unorganized path.
+// Fails with InvalidArgument on bad settings, an empty cloud, a size that
+// does not match width * height, or an infinite coordinate; Cancelled when
+// `cancel` becomes true (checked once per grid row / batch of points).
+absl::StatusOr<LinkClusteringResult> ClusterLinks(
+    const PointCloud& cloud, const LinkClusteringSettings& settings,
+    const std::atomic<bool>* cancel = nullptr);
+
+// The same, reusing `result`'s buffers (no page faults on the steady state
+// of a scan stream). On error `result` holds unspecified contents.
+absl::Status ClusterLinksInto(const PointCloud& cloud,
+                              const LinkClusteringSettings& settings,
+                              LinkClusteringResult& result,
+                              const std::atomic<bool>* cancel = nullptr);
+
+// Grid path on an organized cloud (also accepts height == 1 as one row).
+absl::Status ClusterLinksOrganized(const PointCloud& cloud,
+                                   const LinkClusteringSettings& settings,
+                                   LinkClusteringResult& result,
+                                   const std::atomic<bool>* cancel = nullptr);
+
+// The same cloud with every removed point set to NaN: an organized grid
+// stays the same grid, and kept (and no-data) points are copied bit for bit.
+// InvalidArgument when `result` does not cover this cloud (size mismatch).
+absl::StatusOr<PointCloud> ApplyFilter(const PointCloud& cloud,
+                                       const LinkClusteringResult& result);
+
+namespace internal {
+// Shared by both paths once labels and sizes are known: decides `kept` per
+// cluster and fills kept_mask and the counts.
+void DecideKept(const LinkClusteringSettings& settings, LinkClusteringResult& result);
+// Settings, emptiness and width * height checks shared by both paths (each
+// path rejects infinite coordinates during its own first pass).
+absl::Status CheckInput(const PointCloud& cloud, const LinkClusteringSettings& settings);
+}  // namespace internal
+
+}  // namespace surfinspect
