@@ -177,6 +177,38 @@ void CalibrationToProto(const CalibrationResult& r, v1::CalibrateResponse* msg) 
   for (const auto& w : r.warnings) q->add_warnings(w);
 }
 
+absl::StatusOr<ErrorMapSettings> ErrorMapSettingsFromProto(const v1::ErrorMapSettings& msg,
+                                                           const std::string& field) {
+  ErrorMapSettings s;
+  if (msg.has_tolerance_mm()) s.tolerance_mm = msg.tolerance_mm();
+  if (msg.has_max_distance_mm()) s.max_distance_mm = msg.max_distance_mm();
+  if (msg.has_allowed_fraction_outside()) s.allowed_fraction_outside = msg.allowed_fraction_outside();
+  if (msg.has_histogram_bins()) {
+    if (msg.histogram_bins() > 10001) return Invalid(field + ".histogram_bins", "must be <= 10001");
+    s.histogram_bins = static_cast<int>(msg.histogram_bins());
+  }
+  if (msg.has_histogram_range_mm()) s.histogram_range_mm = msg.histogram_range_mm();
+  s.split_components = msg.split_components();
+  if (!(s.tolerance_mm > 0) || !std::isfinite(s.tolerance_mm))
+    return Invalid(field + ".tolerance_mm", "must be finite and > 0");
+  if (!(s.max_distance_mm > 0)) return Invalid(field + ".max_distance_mm", "must be > 0");
+  if (!(s.allowed_fraction_outside >= 0 && s.allowed_fraction_outside <= 1))
+    return Invalid(field + ".allowed_fraction_outside", "must be in [0, 1]");
+  if (s.histogram_bins < 1) return Invalid(field + ".histogram_bins", "must be >= 1");
+  if (!(s.histogram_range_mm >= 0) || !std::isfinite(s.histogram_range_mm))
+    return Invalid(field + ".histogram_range_mm", "must be finite and >= 0");
+  return s;
+}
+
+void ErrorMapSettingsToProto(const ErrorMapSettings& s, v1::ErrorMapSettings* msg) {
+  msg->set_tolerance_mm(s.tolerance_mm);
+  msg->set_max_distance_mm(s.max_distance_mm);
+  msg->set_allowed_fraction_outside(s.allowed_fraction_outside);
+  msg->set_histogram_bins(static_cast<uint32_t>(s.histogram_bins));
+  msg->set_histogram_range_mm(s.histogram_range_mm);
+  msg->set_split_components(s.split_components);
+}
+
 std::string PackFloats(const std::vector<float>& v) {
   return std::string(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(float));
 }

@@ -10,6 +10,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/calibration.h"
+#include "core/error_map.h"
 #include "core/link_clustering.h"
 #include "core/point_cloud.h"
 #include "core/triangle_mesh.h"
@@ -54,6 +55,10 @@ void FilterStatsToProto(const LinkClusteringResult& r, v1::FilterStats* msg);
 absl::StatusOr<IcpSettings> IcpSettingsFromProto(const v1::IcpSettings& msg, const std::string& field);
 void IcpSettingsToProto(const IcpSettings& s, v1::IcpSettings* msg);
 void CalibrationToProto(const CalibrationResult& r, v1::CalibrateResponse* msg);
+
+absl::StatusOr<ErrorMapSettings> ErrorMapSettingsFromProto(const v1::ErrorMapSettings& msg,
+                                                           const std::string& field);
+void ErrorMapSettingsToProto(const ErrorMapSettings& s, v1::ErrorMapSettings* msg);
 
 // Packs float32 / uint16 / uint32 arrays little-endian.
 std::string PackFloats(const std::vector<float>& v);

@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/calibration.h"
+#include "core/inspection.h"
 #include "core/link_clustering.h"
 #include "core/mesh_hash.h"
 #include "core/registration.h"
@@ -275,6 +276,33 @@ grpc::ServerUnaryReactor* InspectionService::Register(grpc::CallbackServerContex
     resp->mutable_grid_index()->assign(reinterpret_cast<const char*>(merged->grid_index.data()),
                                        merged->grid_index.size() * sizeof(uint32_t));
     for (std::size_t n : merged->points_per_view) resp->add_points_per_view(n);
+    return grpc::Status::OK;
+  });
+}
+
+grpc::ServerUnaryReactor* InspectionService::ErrorMap(grpc::CallbackServerContext* ctx,
+                                                      const v1::ErrorMapRequest* req,
+                                                      v1::ErrorMapResponse* resp) {
+  const uint64_t points = uint64_t{req->cloud().width()} * req->cloud().height();
+  return RunHeavy(ctx, "ErrorMap", points, [this, ctx, req, resp](const std::atomic<bool>& cancel) {
+    auto cloud = wire::CloudFromProto(req->cloud(), "cloud", config_.limits);
+    if (!cloud.ok()) return FromCore(cloud.status());
+    auto world_from_part = wire::TransformFromProto(req->world_from_part(), "world_from_part");
+    if (!world_from_part.ok()) return FromCore(world_from_part.status());
+    auto settings = wire::ErrorMapSettingsFromProto(req->settings(), "settings");
+    if (!settings.ok()) return FromCore(settings.status());
+    std::shared_ptr<const MeshIndex> part;
+    if (grpc::Status st = ResolveMesh(ctx, req->part(), "part", &part); !st.ok()) return st;
+    auto map = ComputeErrorMap(*part, *cloud, *world_from_part, *settings, &cancel);
+    if (!map.ok()) return FromCore(map.status());
+    resp->set_report_json(ErrorMapReportText(*map, *settings));
+    resp->set_verdict(map->verdict.pass ? "pass" : "fail");
+    if (req->return_deviations()) resp->set_deviations(wire::PackFloats(map->deviation_mm));
+    if (req->return_png()) {
+      auto png = ErrorMapPngBytes(*cloud, *world_from_part, *map, part->mesh());
+      if (!png.ok()) return FromCore(png.status());
+      resp->set_png(*std::move(png));
+    }
     return grpc::Status::OK;
   });
 }

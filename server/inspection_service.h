@@ -43,7 +43,11 @@ class InspectionService final : public v1::InspectionService::CallbackService {
   grpc::ServerUnaryReactor* Register(grpc::CallbackServerContext* ctx,
                                      const v1::RegisterRequest* req,
                                      v1::RegisterResponse* resp) override;
-  // ErrorMap and Inspect: see server/error_map_rpc (next step).
+  grpc::ServerUnaryReactor* ErrorMap(grpc::CallbackServerContext* ctx,
+                                     const v1::ErrorMapRequest* req,
+                                     v1::ErrorMapResponse* resp) override;
+  grpc::ServerBidiReactor<v1::InspectRequest, v1::InspectResponse>* Inspect(
+      grpc::CallbackServerContext* ctx) override;
 
   // ---- shared by the reactors ----
   const ServiceConfig& config() const { return config_; }
