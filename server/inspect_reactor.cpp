@@ -31,6 +31,11 @@ grpc::Status InspectReactor::Consume(const v1::InspectRequest& msg) {
         return InvalidField("part.part_id", "must be 1..256 characters");
       if (header_.part().source_case() == v1::MeshRef::SOURCE_NOT_SET)
         return InvalidField("part.part", "mesh is missing (set inline or sha256)");
+      // A mesh sent by hash is looked up now, so a miss fails before the
+      // client streams its views; an inline mesh is indexed on the pool.
+      if (header_.part().source_case() == v1::MeshRef::kSha256)
+        if (grpc::Status st = service_->ResolveMesh(ctx_, header_.part(), "part.part", &part_); !st.ok())
+          return st;
       if (auto t = wire::TransformFromProto(header_.world_from_part(), "part.world_from_part"); !t.ok())
         return ToGrpc(t.status());
       if (auto s = wire::ErrorMapSettingsFromProto(header_.error_map(), "part.error_map"); !s.ok())
@@ -134,8 +139,8 @@ void InspectReactor::OnReadDone(bool ok) {
 void InspectReactor::Compute() {
   grpc::Status st;
   try {
-    std::shared_ptr<const MeshIndex> part;
-    st = service_->ResolveMesh(ctx_, header_.part(), "part.part", &part);
+    std::shared_ptr<const MeshIndex> part = part_;
+    if (!part) st = service_->ResolveMesh(ctx_, header_.part(), "part.part", &part);
     if (st.ok()) {
       InspectionSettings settings;
       settings.filter = !header_.skip_filter();

@@ -50,6 +50,7 @@ class InspectReactor final
   v1::InspectRequest in_;
   State state_ = State::kExpectPart;
   v1::PartHeader header_;
+  std::shared_ptr<const MeshIndex> part_;  // resolved at the header when sent by hash
   std::vector<ViewScan> views_;
   std::string view_bytes_;
   uint32_t view_width_ = 0, view_height_ = 0;
