@@ -141,7 +141,8 @@ enum class PartOutcome { kDone, kQuarantined, kRetryLater };
 
 PartOutcome ProcessPart(const AgentArgs& a, const CellConfig& cell, const TriangleMesh& part,
                         RemoteClient& client, const InboxLayout& layout, const std::string& id,
-                        std::mt19937_64& rng) {
+                        std::mt19937_64& rng, bool* passed) {
+  *passed = false;
   const auto t0 = std::chrono::steady_clock::now();
   if (!IsValidPartId(id)) {
     Quarantine(layout, id, "invalid part id (use letters, digits, . _ -)").IgnoreError();
@@ -210,6 +211,7 @@ PartOutcome ProcessPart(const AgentArgs& a, const CellConfig& cell, const Triang
     return PartOutcome::kRetryLater;
   }
   if (auto st = MovePart(layout.inbox, layout.archive, id); !st.ok()) spdlog::error("{}", std::string(st.message()));
+  *passed = outputs->verdict == "pass";
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("%-16s %-4s  max %+.3f mm  min %+.3f mm  %.1f s\n", id.c_str(), outputs->verdict.c_str(),
               outputs->max_mm, outputs->min_mm, s);
@@ -236,14 +238,12 @@ int Run(const AgentArgs& a) {
     bool progressed = false;
     for (const auto& id : parts) {
       if (g_stop.load()) break;
-      const PartOutcome o = ProcessPart(a, cell, part, *client, layout, id, rng);
+      bool passed = false;
+      const PartOutcome o = ProcessPart(a, cell, part, *client, layout, id, rng, &passed);
       if (o == PartOutcome::kDone) {
         ++done;
+        pass += passed ? 1 : 0;
         progressed = true;
-        std::string report;
-        if (auto r = ReadFileToString(layout.results + "/" + id + "/report.json"); r.ok() &&
-            r->find("\"pass\": true") != std::string::npos)
-          ++pass;
       } else if (o == PartOutcome::kQuarantined) {
         ++quarantined;
         progressed = true;
