@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <csignal>
 #include <thread>
 
 #include "absl/strings/ascii.h"
@@ -10,6 +11,14 @@
 #include "server/run_server.h"
 
 int main(int argc, char** argv) {
+  // Block SIGTERM/SIGINT before any thread exists (gRPC, TBB and the
+  // metrics listener start their own); RunServer waits for them with
+  // sigwait on one thread and drains.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   surfinspect::server::ServerOptions o;
   o.service.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   std::string token_file;

@@ -51,8 +51,9 @@ absl::Status RunServer(const ServerOptions& o) {
   auto metrics = Metrics::Create(o.metrics_listen);
   if (!metrics.ok()) return metrics.status();
 
-  // Handle SIGTERM/SIGINT on one thread of our own: block them here, before
-  // gRPC starts its threads, so they inherit the mask.
+  // Handle SIGTERM/SIGINT on one thread of our own: they are blocked (main
+  // blocks them first thing; this repeats it for other callers), and the
+  // waiter below takes them with sigwait.
   sigset_t signals;
   sigemptyset(&signals);
   sigaddset(&signals, SIGTERM);
