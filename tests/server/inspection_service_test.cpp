@@ -1,7 +1,11 @@
 // Integration tests: a real surfinspectd on a free loopback port, called
 // through the same RemoteClient the CLI and the cell-agent use.
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
 #include <signal.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstring>
@@ -448,6 +452,57 @@ TEST(InspectionService, OverAdmissionIsResourceExhaustedNotACrash) {
   EXPECT_GE(exhausted, 1);
   EXPECT_EQ(ok + exhausted, 4);
   EXPECT_EQ(*ClientFor(server)->Health(), "SERVING");
+}
+
+// GET http://127.0.0.1:PORT/metrics with a plain socket.
+std::string HttpGet(int port, const std::string& path) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<uint16_t>(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  std::string out;
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)) == 0) {
+    const std::string req = "GET " + path + " HTTP/1.0\r\nHost: localhost\r\n\r\n";
+    if (::write(fd, req.data(), req.size()) == static_cast<ssize_t>(req.size())) {
+      char buf[4096];
+      ssize_t n;
+      while ((n = ::read(fd, buf, sizeof(buf))) > 0) out.append(buf, static_cast<std::size_t>(n));
+    }
+  }
+  ::close(fd);
+  return out;
+}
+
+int FreePort() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr));
+  socklen_t len = sizeof(addr);
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
+  ::close(fd);
+  return ntohs(addr.sin_port);
+}
+
+TEST(InspectionService, PrometheusMetricsCountCallsPointsAndCache) {
+  const int metrics_port = FreePort();
+  testing::ServerProcess server({"--metrics-listen", "127.0.0.1:" + std::to_string(metrics_port)});
+  ASSERT_TRUE(server.started());
+  const Data& d = TestData();
+  auto client = ClientFor(server);
+  ASSERT_TRUE(client->ErrorMap(ErrorMapRequest(d.views[0].cloud_in_sensor), d.cell.part).ok());
+  ASSERT_TRUE(client->ErrorMap(ErrorMapRequest(d.views[0].cloud_in_sensor), d.cell.part).ok());
+  v1::FilterRequest bad;
+  EXPECT_FALSE(client->Filter(bad).ok());
+  const std::string text = HttpGet(metrics_port, "/metrics");
+  EXPECT_NE(text.find("surfinspect_rpcs_total{code=\"OK\",method=\"ErrorMap\"} 2"), std::string::npos) << text;
+  EXPECT_NE(text.find("surfinspect_rpcs_total{code=\"INVALID_ARGUMENT\",method=\"Filter\"} 1"), std::string::npos);
+  EXPECT_NE(text.find("surfinspect_mesh_cache_lookups_total{result=\"hit\"} 1"), std::string::npos);
+  EXPECT_NE(text.find("surfinspect_rpc_duration_seconds_count{method=\"ErrorMap\"} 3"), std::string::npos);
+  EXPECT_NE(text.find("surfinspect_points_processed_total " + std::to_string(2 * d.views[0].cloud_in_sensor.size())),
+            std::string::npos);
 }
 
 }  // namespace
