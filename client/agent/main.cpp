@@ -175,15 +175,7 @@ PartOutcome ProcessPart(const AgentArgs& a, const CellConfig& cell, const Triang
     Quarantine(layout, id, "no <viewpoint>.pcd scan of this cell's viewpoints").IgnoreError();
     return PartOutcome::kQuarantined;
   }
-  v1::PartHeader header;
-  header.set_part_id(id);
-  header.set_idempotency_key(id);
-  wire::TransformToProto(cell.world_from_part, header.mutable_world_from_part());
-  wire::ErrorMapSettingsToProto(cell.error_map, header.mutable_error_map());
-  wire::FilterSettingsToProto(cell.filter_settings, header.mutable_filter());
-  header.set_skip_filter(!cell.filter);
-  header.set_return_deviations(true);
-  header.set_return_png(true);
+  const v1::PartHeader header = MakePartHeader(id, cell.world_from_part, InspectionSettingsOf(cell));
   const bool tty = isatty(STDERR_FILENO);
   absl::StatusOr<v1::InspectResult> result;
   for (int attempt = 0;; ++attempt) {

@@ -106,6 +106,14 @@ absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
   return c;
 }
 
+InspectionSettings InspectionSettingsOf(const CellConfig& cell) {
+  InspectionSettings s;
+  s.filter = cell.filter;
+  s.filter_settings = cell.filter_settings;
+  s.error_map = cell.error_map;
+  return s;
+}
+
 absl::Status WriteCellCalibrations(const CellConfig& cell,
                                    const std::vector<std::pair<std::string, nlohmann::json>>& quality) {
   nlohmann::json j = cell.raw;

@@ -20,6 +20,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/error_map.h"
+#include "core/inspection.h"
 #include "core/link_clustering.h"
 
 namespace surfinspect::client {
@@ -49,6 +50,9 @@ struct CellConfig {
 };
 
 absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path);
+
+// The cell's filter and error-map settings as one InspectionSettings.
+InspectionSettings InspectionSettingsOf(const CellConfig& cell);
 
 // Stores each calibrated viewpoint's world_from_sensor and quality (JSON)
 // into the file: the previous file is kept as cell.json.bak, the new one is

@@ -62,6 +62,20 @@ absl::StatusOr<PartOutputs> OutputsFromRemote(const v1::InspectResult& r) {
   return o;
 }
 
+v1::PartHeader MakePartHeader(const std::string& part_id, const Eigen::Isometry3d& world_from_part,
+                              const InspectionSettings& settings) {
+  v1::PartHeader header;
+  header.set_part_id(part_id);
+  header.set_idempotency_key(part_id);  // a part is inspected once, whoever asks
+  wire::TransformToProto(world_from_part, header.mutable_world_from_part());
+  wire::ErrorMapSettingsToProto(settings.error_map, header.mutable_error_map());
+  wire::FilterSettingsToProto(settings.filter_settings, header.mutable_filter());
+  header.set_skip_filter(!settings.filter);
+  header.set_return_deviations(true);
+  header.set_return_png(true);
+  return header;
+}
+
 absl::Status WritePartOutputs(const std::string& dir, const PartOutputs& o) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);

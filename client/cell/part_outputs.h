@@ -32,6 +32,12 @@ absl::StatusOr<PartOutputs> OutputsFromLocal(const std::string& part_id, const I
                                              const TriangleMesh& part);
 absl::StatusOr<PartOutputs> OutputsFromRemote(const ::surfinspect::v1::InspectResult& r);
 
+// The Inspect stream's header for a part, asking for everything the part
+// outputs need (deviations, merged cloud and PNG).
+::surfinspect::v1::PartHeader MakePartHeader(const std::string& part_id,
+                                             const Eigen::Isometry3d& world_from_part,
+                                             const InspectionSettings& settings);
+
 absl::Status WritePartOutputs(const std::string& dir, const PartOutputs& outputs);
 
 }  // namespace surfinspect::client

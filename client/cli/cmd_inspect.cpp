@@ -26,10 +26,7 @@ struct InspectArgs {
 void Inspect(const InspectArgs& a) {
   const client::CellConfig cell = Take(client::ReadCellConfig(a.cell));
   const TriangleMesh part = Take(ReadMesh(cell.part_mesh));
-  InspectionSettings settings;
-  settings.filter = cell.filter;
-  settings.filter_settings = cell.filter_settings;
-  settings.error_map = cell.error_map;
+  InspectionSettings settings = client::InspectionSettingsOf(cell);
   if (a.tolerance > 0) settings.error_map.tolerance_mm = a.tolerance;
   std::vector<ViewScan> views;
   for (const auto& vp : cell.viewpoints) {
@@ -44,15 +41,7 @@ void Inspect(const InspectArgs& a) {
       a.part_id.empty() ? std::filesystem::path(a.scans).filename().string() : a.part_id;
   client::PartOutputs outputs;
   if (a.remote.remote()) {
-    v1::PartHeader header;
-    header.set_part_id(part_id);
-    header.set_idempotency_key(part_id);
-    wire::TransformToProto(cell.world_from_part, header.mutable_world_from_part());
-    wire::ErrorMapSettingsToProto(settings.error_map, header.mutable_error_map());
-    wire::FilterSettingsToProto(settings.filter_settings, header.mutable_filter());
-    header.set_skip_filter(!settings.filter);
-    header.set_return_deviations(true);
-    header.set_return_png(true);
+    const v1::PartHeader header = client::MakePartHeader(part_id, cell.world_from_part, settings);
     auto result = Take(Connect(a.remote)->Inspect(header, part, views, [](const v1::Progress& p) {
       spdlog::info("{} {} ({} points)", v1::Progress::Stage_Name(p.stage()), p.view(), p.points());
     }));
