@@ -14,6 +14,13 @@ namespace {
 
 constexpr int32_t kInvalid = LinkClusteringResult::kInvalid;
 
+// The random inputs below are scaled for a 0.5 mm link distance.
+LinkClusteringSettings HalfMm() {
+  LinkClusteringSettings s;
+  s.link_distance_mm = 0.5;
+  return s;
+}
+
 // Brute-force oracle for the grid: BFS from every unvisited valid pixel over
 // the 4 or 8 grid neighbours, linking with the same predicate.
 std::vector<int32_t> GridOracle(const PointCloud& c, int connectivity, float r2) {
@@ -170,7 +177,7 @@ TEST(LinkClusteringGrid, MatchesBfsOracleOnRandomGrids) {
     const uint32_t w = size(rng) - 1, h = size(rng);  // w may be 1
     const PointCloud c = RandomGrid(rng, w, h, trial % 4 == 0 ? 0.0 : 0.2);
     for (int conn : {4, 8}) {
-      LinkClusteringSettings s;
+      LinkClusteringSettings s = HalfMm();
       s.connectivity = conn;
       s.min_cluster_points = 1 + trial % 7;
       s.min_fraction_of_largest = trial % 3 == 0 ? 0.1 : 0.0;
@@ -198,7 +205,7 @@ TEST(LinkClusteringGrid, SnakesAndSpiralsNeedManyMerges) {
         const bool on = (col % 2 == 0) || (r == (col % 4 == 1 ? h - 1 : 0));
         c.points[r * w + col] = {0.3f * col, 0.3f * r, on ? 0.f : 5.f + 7.f * ((r + col) % 2)};
       }
-    LinkClusteringSettings s;
+    LinkClusteringSettings s = HalfMm();
     s.connectivity = conn;
     auto r = ClusterLinks(c, s);
     ASSERT_TRUE(r.ok());
@@ -212,9 +219,9 @@ TEST(LinkClusteringGrid, SingleRowAndSingleColumn) {
   for (auto [w, h] : {std::pair<uint32_t, uint32_t>{50, 1}, {1, 50}, {1, 2}}) {
     const PointCloud c = RandomGrid(rng, w, h, 0.1);
     LinkClusteringResult r;
-    ASSERT_TRUE(ClusterLinksOrganized(c, {}, r).ok());
+    ASSERT_TRUE(ClusterLinksOrganized(c, HalfMm(), r).ok());
     ExpectSamePartition(r.labels, GridOracle(c, 8, LinkDistanceSquared(0.5)));
-    ExpectConsistent(c, r, {});
+    ExpectConsistent(c, r, HalfMm());
   }
 }
 
@@ -242,7 +249,7 @@ TEST(LinkClusteringUnorganized, MatchesPairwiseOracle) {
   std::uniform_int_distribution<std::size_t> size(1, 400);
   for (int trial = 0; trial < 150; ++trial) {
     LinkClusteringSettings s;
-    s.link_distance_mm = trial % 2 ? 0.5 : 0.37;
+    s.link_distance_mm = trial % 2 ? 0.85 : 0.37;
     s.min_cluster_points = 1 + trial % 5;
     s.min_fraction_of_largest = trial % 3 == 0 ? 0.2 : 0.0;
     const PointCloud c = RandomCloud(rng, size(rng), static_cast<float>(s.link_distance_mm));
@@ -263,7 +270,7 @@ TEST(LinkClusteringUnorganized, FloatRoundingAtCellBordersStillLinks) {
   ASSERT_TRUE(PointsLinked({a, 0, 0}, {b, 0, 0}, LinkDistanceSquared(0.5)));
   ASSERT_EQ(std::floor((double{a} - lo) / 0.5) - std::floor((double{b} - lo) / 0.5), 2.0);
   const PointCloud c = PointCloud::Unorganized({{lo, 0, 0}, {a, 0, 0}, {b, 0, 0}});
-  auto r = ClusterLinks(c, {});
+  auto r = ClusterLinks(c, HalfMm());
   ASSERT_TRUE(r.ok());
   EXPECT_EQ(r->labels[1], r->labels[2]);
   EXPECT_EQ(r->clusters.size(), 2u);
@@ -274,7 +281,7 @@ TEST(LinkClusteringUnorganized, OrganizedCloudThroughGeneralPathLinksAllPairs) {
   // each other link there, not on the grid path.
   PointCloud c = PointCloud::Organized(4, 2);
   for (uint32_t i = 0; i < 8; ++i) c.points[i] = {(i % 4 == 3) ? 0.f : 10.f * i, 0.f, 0.f};
-  LinkClusteringSettings s;
+  LinkClusteringSettings s = HalfMm();
   s.min_cluster_points = 1;
   LinkClusteringResult grid, general;
   ASSERT_TRUE(ClusterLinksOrganized(c, s, grid).ok());
@@ -324,7 +331,7 @@ TEST(LinkClustering, ApplyFilterKeepsBitsAndGrid) {
   // A NaN payload in a no-data pixel must survive too.
   uint32_t payload = 0x7fc00123u;
   std::memcpy(c.points[5].data(), &payload, 4);
-  LinkClusteringSettings s;
+  LinkClusteringSettings s = HalfMm();
   s.min_cluster_points = 4;
   auto r = ClusterLinks(c, s);
   ASSERT_TRUE(r.ok());
