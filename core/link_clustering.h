@@ -7,9 +7,8 @@
 //
 // Two paths with the same semantics for "linked":
 //  * organized grid (the fast path for sensor data): only 4- or 8-neighbours
-//    in the sensor grid may link; a two-pass union-find over the grid
-//    (Wu, Otoo & Suzuki, "Optimizing two-pass connected-component labeling
-//    algorithms", 2009) with the parent forest stored in the label array;
+//    in the sensor grid may link; a run-based two-pass union-find over the
+//    grid, see link_clustering_grid.h;
 //  * unorganized (the general path): every pair within the link distance
 //    links, found with a hashed voxel grid whose cell edge equals the link
 //    distance (27 neighbouring cells), see link_clustering_unorganized.h.
@@ -106,12 +105,6 @@ absl::Status ClusterLinksInto(const PointCloud& cloud,
                               LinkClusteringResult& result,
                               const std::atomic<bool>* cancel = nullptr);
 
-// Grid path on an organized cloud (also accepts height == 1 as one row).
-absl::Status ClusterLinksOrganized(const PointCloud& cloud,
-                                   const LinkClusteringSettings& settings,
-                                   LinkClusteringResult& result,
-                                   const std::atomic<bool>* cancel = nullptr);
-
 // The same cloud with every removed point set to NaN: an organized grid
 // stays the same grid, and kept (and no-data) points are copied bit for bit.
 // InvalidArgument when `result` does not cover this cloud (size mismatch).
@@ -119,9 +112,11 @@ absl::StatusOr<PointCloud> ApplyFilter(const PointCloud& cloud,
                                        const LinkClusteringResult& result);
 
 namespace internal {
-// Shared by both paths once labels and sizes are known: decides `kept` per
-// cluster and fills kept_mask and the counts.
-void DecideKept(const LinkClusteringSettings& settings, LinkClusteringResult& result);
+// Shared by both paths once the clusters and their sizes are known: decides
+// `kept` per cluster and fills the counts (not the mask).
+void DecideClusters(const LinkClusteringSettings& settings, LinkClusteringResult& result);
+// kept_mask from labels and the clusters' `kept` flags, point by point.
+void FillKeptMaskFromLabels(LinkClusteringResult& result);
 // Settings, emptiness and width * height checks shared by both paths (each
 // path rejects infinite coordinates during its own first pass).
 absl::Status CheckInput(const PointCloud& cloud, const LinkClusteringSettings& settings);

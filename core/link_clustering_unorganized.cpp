@@ -209,7 +209,8 @@ absl::Status ClusterLinksUnorganized(const PointCloud& cloud,
     k.max = k.max.cwiseMax(p);
     result.labels[i] = id;
   }
-  internal::DecideKept(settings, result);
+  internal::DecideClusters(settings, result);
+  internal::FillKeptMaskFromLabels(result);
   return absl::OkStatus();
 }
 

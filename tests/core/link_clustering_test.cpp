@@ -7,6 +7,7 @@
 #include <queue>
 #include <random>
 
+#include "core/link_clustering_grid.h"
 #include "core/link_clustering_unorganized.h"
 
 namespace surfinspect {
@@ -186,6 +187,35 @@ TEST(LinkClusteringGrid, MatchesBfsOracleOnRandomGrids) {
       EXPECT_TRUE(r->organized_path);
       SCOPED_TRACE(testing::Message() << "trial " << trial << " " << w << "x" << h << " conn "
                                       << conn);
+      ExpectSamePartition(r->labels, GridOracle(c, conn, LinkDistanceSquared(0.5)));
+      ExpectConsistent(c, *r, s);
+      if (HasFatalFailure()) return;
+    }
+  }
+}
+
+TEST(LinkClusteringGrid, WideGridsCrossMaskWords) {
+  // Rows wider than 64 pixels span several 64-bit link masks; runs and
+  // links must carry across the word boundaries. Smooth heights make long
+  // runs, so many of them cross a boundary.
+  std::mt19937 rng(17);
+  std::uniform_int_distribution<uint32_t> width(60, 300), height(2, 12);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  for (int trial = 0; trial < 60; ++trial) {
+    const uint32_t w = width(rng), h = height(rng);
+    PointCloud c = trial % 2 ? RandomGrid(rng, w, h, 0.05) : PointCloud::Organized(w, h);
+    if (trial % 2 == 0)
+      for (uint32_t r = 0; r < h; ++r)
+        for (uint32_t col = 0; col < w; ++col)
+          if (u(rng) > 0.02f)
+            c.points[r * w + col] = {0.3f * col, 0.3f * r, u(rng) < 0.03f ? 3.f : 0.1f * u(rng)};
+    for (int conn : {4, 8}) {
+      LinkClusteringSettings s = HalfMm();
+      s.connectivity = conn;
+      s.min_cluster_points = 3;
+      auto r = ClusterLinks(c, s);
+      ASSERT_TRUE(r.ok());
+      SCOPED_TRACE(testing::Message() << "trial " << trial << " " << w << "x" << h);
       ExpectSamePartition(r->labels, GridOracle(c, conn, LinkDistanceSquared(0.5)));
       ExpectConsistent(c, *r, s);
       if (HasFatalFailure()) return;
