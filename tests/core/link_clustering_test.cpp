@@ -294,8 +294,9 @@ TEST(LinkClusteringUnorganized, MatchesPairwiseOracle) {
 }
 
 TEST(LinkClusteringUnorganized, FloatRoundingAtCellBordersStillLinks) {
-  // Found by search: PointsLinked (float) links a and b, but with cells of
-  // exactly 0.5 mm from the origin lo their cells would be 2 apart.
+  // Found by search: PointsLinked (float) links a and b, but in a grid of
+  // cells of exactly 0.5 mm from the origin lo their cells would be 2 apart
+  // (a float-rounding trap for any voxel scheme).
   const float lo = -255.444946f, a = 0.555053711f, b = 0.0550536998f;
   ASSERT_TRUE(PointsLinked({a, 0, 0}, {b, 0, 0}, LinkDistanceSquared(0.5)));
   ASSERT_EQ(std::floor((double{a} - lo) / 0.5) - std::floor((double{b} - lo) / 0.5), 2.0);
@@ -304,6 +305,28 @@ TEST(LinkClusteringUnorganized, FloatRoundingAtCellBordersStillLinks) {
   ASSERT_TRUE(r.ok());
   EXPECT_EQ(r->labels[1], r->labels[2]);
   EXPECT_EQ(r->clusters.size(), 2u);
+}
+
+TEST(LinkClusteringUnorganized, CellDiagonalsJustBeyondTheLinkDistanceDoNotLink) {
+  // Points of one voxel cell are linked without a test, so no cell may hold
+  // two points farther apart than the link distance: pairs along the cell
+  // diagonal at d (1 +- delta) must link exactly when PointsLinked says so.
+  for (double d : {0.37, 0.5, 0.85, 1.3})
+    for (double delta : {-1e-3, -1e-4, 1e-4, 1e-3})
+      for (int signs = 0; signs < 8; ++signs) {
+        LinkClusteringSettings s;
+        s.link_distance_mm = d;
+        s.min_cluster_points = 1;
+        const Eigen::Vector3f a(1.5f, -0.75f, 2.25f);  // small: float keeps delta
+        const Eigen::Vector3f dir((signs & 1) ? -1.f : 1.f, (signs & 2) ? -1.f : 1.f,
+                                  (signs & 4) ? -1.f : 1.f);
+        const Eigen::Vector3f b = a + dir * static_cast<float>(d / std::sqrt(3.0) * (1 + delta));
+        const bool linked = PointsLinked(a, b, LinkDistanceSquared(d));
+        ASSERT_EQ(linked, delta < 0) << d << " " << delta;
+        auto r = ClusterLinks(PointCloud::Unorganized({a, b}), s);
+        ASSERT_TRUE(r.ok());
+        EXPECT_EQ(r->labels[0] == r->labels[1], linked) << d << " " << delta << " " << signs;
+      }
 }
 
 TEST(LinkClusteringUnorganized, OrganizedCloudThroughGeneralPathLinksAllPairs) {
