@@ -61,70 +61,80 @@ void Transpose(const Eigen::Vector3f* pts, uint32_t w, RowSoA& row) {
   for (; i < w; ++i, f += 3) x[i] = f[0], y[i] = f[1], z[i] = f[2];
 }
 
-// bits[k] bit j = PointsLinked(a[64k + j], b[64k + j]), same float
-// operations in the same order as PointsLinked.
-void LinkBits(const float* ax, const float* ay, const float* az, const float* bx,
-              const float* by, const float* bz, uint32_t words, float r2, uint64_t* bits) {
-  for (uint32_t k = 0; k < words; ++k) {
-    uint64_t word = 0;
-    const uint32_t base = 64 * k;
-#if defined(__SSE2__)
-    const __m128 r = _mm_set1_ps(r2);
-    for (uint32_t j = 0; j < 64; j += 4) {
-      const uint32_t i = base + j;
-      const __m128 dx = _mm_sub_ps(_mm_loadu_ps(ax + i), _mm_loadu_ps(bx + i));
-      const __m128 dy = _mm_sub_ps(_mm_loadu_ps(ay + i), _mm_loadu_ps(by + i));
-      const __m128 dz = _mm_sub_ps(_mm_loadu_ps(az + i), _mm_loadu_ps(bz + i));
-      const __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)),
-                                   _mm_mul_ps(dz, dz));
-      word |= uint64_t(_mm_movemask_ps(_mm_cmple_ps(d2, r))) << j;
-    }
-#else
-    for (uint32_t j = 0; j < 64; ++j) {
-      const uint32_t i = base + j;
-      const float dx = ax[i] - bx[i], dy = ay[i] - by[i], dz = az[i] - bz[i];
-      word |= uint64_t(dx * dx + dy * dy + dz * dz <= r2) << j;
-    }
-#endif
-    bits[k] = word;
-  }
-}
+// Per-row bit masks, bit j of word k for pixel 64k + j.
+struct RowMasks {
+  uint64_t *valid, *west, *north_west, *north, *north_east;
+};
 
-// Valid bits (all coordinates finite: 0 * NaN and 0 * inf are NaN); returns
-// whether an infinite coordinate was seen, which the cloud contract forbids.
-bool ValidBits(const RowSoA& row, uint32_t words, uint64_t* bits) {
-  const float* __restrict x = row.c(0);
-  const float* __restrict y = row.c(1);
-  const float* __restrict z = row.c(2);
 #if defined(__SSE2__)
-  const __m128 zero = _mm_setzero_ps(), inf = _mm_set1_ps(INFINITY);
+// 4 link tests at once, the float operations of PointsLinked in its order.
+inline uint64_t Link4(__m128 px, __m128 py, __m128 pz, const float* bx, const float* by,
+                      const float* bz, __m128 r2) {
+  const __m128 dx = _mm_sub_ps(px, _mm_loadu_ps(bx));
+  const __m128 dy = _mm_sub_ps(py, _mm_loadu_ps(by));
+  const __m128 dz = _mm_sub_ps(pz, _mm_loadu_ps(bz));
+  const __m128 d2 =
+      _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+  return static_cast<uint64_t>(_mm_movemask_ps(_mm_cmple_ps(d2, r2)));
+}
+#endif
+
+// One pass over a row in SoA form: valid bits (all coordinates finite, as
+// 0 * NaN and 0 * inf are NaN), west links and, with a row above, north
+// (and north-west / north-east) links; NaN never links. Returns whether an
+// infinite coordinate was seen, which the cloud contract forbids.
+template <bool kAbove, bool kDiagonals>
+bool RowBits(const RowSoA& cur, const RowSoA& up, uint32_t words, float r2, const RowMasks& m) {
+  const float *x = cur.c(0), *y = cur.c(1), *z = cur.c(2);
+  const float *ux = up.c(0), *uy = up.c(1), *uz = up.c(2);
+#if defined(__SSE2__)
+  const __m128 zero = _mm_setzero_ps(), inf = _mm_set1_ps(INFINITY), r = _mm_set1_ps(r2);
   const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
   __m128 any_inf = zero;
   for (uint32_t k = 0; k < words; ++k) {
-    uint64_t word = 0;
+    uint64_t valid = 0, west = 0, north_west = 0, north = 0, north_east = 0;
     for (uint32_t j = 0; j < 64; j += 4) {
       const uint32_t i = 64 * k + j;
-      const __m128 vx = _mm_loadu_ps(x + i), vy = _mm_loadu_ps(y + i), vz = _mm_loadu_ps(z + i);
-      const __m128 s = _mm_add_ps(_mm_add_ps(_mm_mul_ps(vx, zero), _mm_mul_ps(vy, zero)),
-                                  _mm_mul_ps(vz, zero));
-      word |= uint64_t(_mm_movemask_ps(_mm_cmpeq_ps(s, zero))) << j;
-      const __m128 m = _mm_max_ps(_mm_and_ps(vx, abs_mask),
-                                  _mm_max_ps(_mm_and_ps(vy, abs_mask), _mm_and_ps(vz, abs_mask)));
-      any_inf = _mm_or_ps(any_inf, _mm_cmpeq_ps(m, inf));
+      const __m128 px = _mm_loadu_ps(x + i), py = _mm_loadu_ps(y + i), pz = _mm_loadu_ps(z + i);
+      const __m128 s = _mm_add_ps(_mm_add_ps(_mm_mul_ps(px, zero), _mm_mul_ps(py, zero)),
+                                  _mm_mul_ps(pz, zero));
+      valid |= uint64_t(_mm_movemask_ps(_mm_cmpeq_ps(s, zero))) << j;
+      any_inf = _mm_or_ps(any_inf, _mm_or_ps(_mm_cmpeq_ps(_mm_and_ps(px, abs_mask), inf),
+                                             _mm_cmpeq_ps(_mm_and_ps(py, abs_mask), inf)));
+      any_inf = _mm_or_ps(any_inf, _mm_cmpeq_ps(_mm_and_ps(pz, abs_mask), inf));
+      west |= Link4(px, py, pz, x + i - 1, y + i - 1, z + i - 1, r) << j;
+      if (kAbove) north |= Link4(px, py, pz, ux + i, uy + i, uz + i, r) << j;
+      if (kDiagonals) {
+        north_west |= Link4(px, py, pz, ux + i - 1, uy + i - 1, uz + i - 1, r) << j;
+        north_east |= Link4(px, py, pz, ux + i + 1, uy + i + 1, uz + i + 1, r) << j;
+      }
     }
-    bits[k] = word;
+    m.valid[k] = valid, m.west[k] = west;
+    m.north_west[k] = north_west, m.north[k] = north, m.north_east[k] = north_east;
   }
   return _mm_movemask_ps(any_inf) != 0;
 #else
   bool any_inf = false;
+  const float r2f = r2;
+  auto p = [](const float* a, const float* b, const float* c, uint32_t i) {
+    return Eigen::Vector3f(a[i], b[i], c[i]);
+  };
   for (uint32_t k = 0; k < words; ++k) {
-    uint64_t word = 0;
+    uint64_t valid = 0, west = 0, north_west = 0, north = 0, north_east = 0;
     for (uint32_t j = 0; j < 64; ++j) {
       const uint32_t i = 64 * k + j;
-      word |= uint64_t(x[i] * 0.f + y[i] * 0.f + z[i] * 0.f == 0.f) << j;
-      any_inf |= std::isinf(x[i]) || std::isinf(y[i]) || std::isinf(z[i]);
+      const Eigen::Vector3f q = p(x, y, z, i);
+      valid |= uint64_t(q.x() * 0.f + q.y() * 0.f + q.z() * 0.f == 0.f) << j;
+      any_inf |= q.array().isInf().any();
+      west |= uint64_t(PointsLinked(q, p(x, y, z, i - 1), r2f)) << j;
+      if (kAbove) north |= uint64_t(PointsLinked(q, p(ux, uy, uz, i), r2f)) << j;
+      if (kDiagonals) {
+        north_west |= uint64_t(PointsLinked(q, p(ux, uy, uz, i - 1), r2f)) << j;
+        north_east |= uint64_t(PointsLinked(q, p(ux, uy, uz, i + 1), r2f)) << j;
+      }
     }
-    bits[k] = word;
+    m.valid[k] = valid, m.west[k] = west;
+    m.north_west[k] = north_west, m.north[k] = north, m.north_east[k] = north_east;
   }
   return any_inf;
 #endif
@@ -203,11 +213,11 @@ absl::Status ClusterLinksOrganized(const PointCloud& cloud,
   RowSoA rows[2] = {RowSoA(64 * words), RowSoA(64 * words)};
   // Masks: valid, west, north-west, north, north-east, run starts, run ends.
   std::vector<uint64_t> masks(7 * std::size_t{words});
-  uint64_t* valid = masks.data();
-  uint64_t* west = valid + words;
-  uint64_t* vertical[3] = {west + words, west + 2 * words, west + 3 * words};
-  uint64_t* starts = west + 4 * words;
-  uint64_t* ends = west + 5 * words;
+  const RowMasks m = {masks.data(), masks.data() + words, masks.data() + 2 * words,
+                      masks.data() + 3 * words, masks.data() + 4 * words};
+  uint64_t* const vertical[3] = {m.north_west, m.north, m.north_east};
+  uint64_t* starts = masks.data() + 5 * words;
+  uint64_t* ends = masks.data() + 6 * words;
   std::vector<int32_t> run_of[2] = {std::vector<int32_t>(w), std::vector<int32_t>(w)};
   std::vector<Run> runs;
   std::vector<int32_t> parent;
@@ -228,21 +238,19 @@ absl::Status ClusterLinksOrganized(const PointCloud& cloud,
       for (std::size_t b = 0; b < std::size_t{w} * sizeof(Eigen::Vector3f); b += 64)
         __builtin_prefetch(next + b);
     }
-    if (ValidBits(cur, words, valid))
+    const bool above = r > 0;
+    const bool any_inf = !above  ? RowBits<false, false>(cur, up, words, r2, m)
+                         : eight ? RowBits<true, true>(cur, up, words, r2, m)
+                                 : RowBits<true, false>(cur, up, words, r2, m);
+    if (any_inf)
       return absl::InvalidArgumentError(
           absl::StrCat("link clustering: row ", r, " holds an infinite coordinate"));
-    LinkBits(cur.c(0), cur.c(1), cur.c(2), cur.c(0) - 1, cur.c(1) - 1, cur.c(2) - 1, words,
-             r2, west);
     const int offsets[3] = {-1, 0, 1};  // north-west, north, north-east
-    const bool use[3] = {eight && r > 0, r > 0, eight && r > 0};
-    for (int k = 0; k < 3; ++k)
-      if (use[k])
-        LinkBits(cur.c(0), cur.c(1), cur.c(2), up.c(0) + offsets[k], up.c(1) + offsets[k],
-                 up.c(2) + offsets[k], words, r2, vertical[k]);
+    const bool use[3] = {eight && above, above, eight && above};
     for (uint32_t k = 0; k < words; ++k) {
-      const uint64_t west_of_next = (west[k] >> 1) | (k + 1 < words ? west[k + 1] << 63 : 0);
-      starts[k] = valid[k] & ~west[k];
-      ends[k] = valid[k] & ~west_of_next;
+      const uint64_t west_of_next = (m.west[k] >> 1) | (k + 1 < words ? m.west[k + 1] << 63 : 0);
+      starts[k] = m.valid[k] & ~m.west[k];
+      ends[k] = m.valid[k] & ~west_of_next;
     }
     std::vector<int32_t>& run_here = run_of[r & 1];
     const std::vector<int32_t>& run_above = run_of[(r + 1) & 1];
@@ -259,9 +267,9 @@ absl::Status ClusterLinksOrganized(const PointCloud& cloud,
         // reach that same run: merge once, then skip past it.
         for (uint32_t c = NextBit(vertical[k], words, s); c <= e;
              c = NextBit(vertical[k], words, c)) {
-          const int32_t above = run_above[c + offsets[k]];
-          Union(parent, id, above);
-          const int64_t past = int64_t{runs[above].last_col} - offsets[k] + 1;
+          const int32_t run_up = run_above[c + offsets[k]];
+          Union(parent, id, run_up);
+          const int64_t past = int64_t{runs[run_up].last_col} - offsets[k] + 1;
           c = static_cast<uint32_t>(std::max<int64_t>(c + 1, past));
           if (c >= w) break;
         }

@@ -442,6 +442,15 @@ TEST(LinkClustering, BadInputGivesClearErrors) {
   PointCloud inf_grid = PointCloud::Organized(4, 4);
   inf_grid.points[6] = {1.f, INFINITY, 0.f};
   expect_error(inf_grid, {}, "infinite");
+  // An infinity next to a NaN in the same point is still an infinity.
+  for (const Eigen::Vector3f& p : {Eigen::Vector3f(INFINITY, 0.f, NAN),
+                                   Eigen::Vector3f(NAN, NAN, -INFINITY),
+                                   Eigen::Vector3f(NAN, INFINITY, 2.f)}) {
+    PointCloud g = PointCloud::Organized(70, 3);  // the bad pixel in word 2
+    g.points[2 * 70 + 66] = p;
+    expect_error(g, {}, "infinite");
+    expect_error(PointCloud::Unorganized({{0, 0, 0}, p}), {}, "infinite");
+  }
   expect_error(PointCloud::Unorganized({{0, 0, 0}, {0, 0, -INFINITY}}), {}, "infinite");
   // 1 um links across 10 km: more cells than the key can hold.
   LinkClusteringSettings fine;
