@@ -85,22 +85,22 @@ bool RowBits(const RowSoA& cur, const RowSoA& up, uint32_t words, float r2, cons
   return _mm_movemask_ps(any_inf) != 0;
 #else
   bool any_inf = false;
-  const float r2f = r2;
-  auto p = [](const float* a, const float* b, const float* c, uint32_t i) {
-    return Eigen::Vector3f(a[i], b[i], c[i]);
+  // Neighbours through shifted pointers: index i - 1 would wrap at i = 0.
+  auto at = [](const float* a, const float* b, const float* c, int shift, uint32_t i) {
+    return Eigen::Vector3f((a + shift)[i], (b + shift)[i], (c + shift)[i]);
   };
   for (uint32_t k = 0; k < words; ++k) {
     uint64_t valid = 0, west = 0, north_west = 0, north = 0, north_east = 0;
     for (uint32_t j = 0; j < 64; ++j) {
       const uint32_t i = 64 * k + j;
-      const Eigen::Vector3f q = p(x, y, z, i);
+      const Eigen::Vector3f q = at(x, y, z, 0, i);
       valid |= uint64_t(q.x() * 0.f + q.y() * 0.f + q.z() * 0.f == 0.f) << j;
       any_inf |= q.array().isInf().any();
-      west |= uint64_t(PointsLinked(q, p(x, y, z, i - 1), r2f)) << j;
-      if (kAbove) north |= uint64_t(PointsLinked(q, p(ux, uy, uz, i), r2f)) << j;
+      west |= uint64_t(PointsLinked(q, at(x, y, z, -1, i), r2)) << j;
+      if (kAbove) north |= uint64_t(PointsLinked(q, at(ux, uy, uz, 0, i), r2)) << j;
       if (kDiagonals) {
-        north_west |= uint64_t(PointsLinked(q, p(ux, uy, uz, i - 1), r2f)) << j;
-        north_east |= uint64_t(PointsLinked(q, p(ux, uy, uz, i + 1), r2f)) << j;
+        north_west |= uint64_t(PointsLinked(q, at(ux, uy, uz, -1, i), r2)) << j;
+        north_east |= uint64_t(PointsLinked(q, at(ux, uy, uz, 1, i), r2)) << j;
       }
     }
     m.valid[k] = valid, m.west[k] = west;
