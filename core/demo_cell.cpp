@@ -144,7 +144,7 @@ TriangleMesh MakeGaugeMesh() {
   // at asymmetric spots: together they pin all six degrees of freedom.
   TriangleMesh m;
   AddBox(m, {-80, -60, -10}, {80, 60, 0});
-  AddBox(m, {10, -60, 0}, {80, 60, 15});
+  AddBox(m, {10, -55, 0}, {75, 55, 15});  // inset: no edge shared with the plate
   AddSphere(m, {-45, -25, 12}, 12, 48, 24);
   AddSphere(m, {-30, 30, 18}, 18, 48, 24);
   AddSphere(m, {45, 5, 15 + 20}, 20, 48, 24);

@@ -7,11 +7,10 @@ OUT=${2:?output dir}
 mkdir -p "$OUT"
 say() { printf '\n\033[1m== %s\033[0m\n' "$*"; }
 
-say "surfinspect $("$BIN/surfinspect" --version)"
+say "$("$BIN/surfinspect" --version)"
 say "Demo cell: part, gauge, viewpoints and simulated scans -> $OUT/cell"
-"$BIN/surfinspect" demo-cell --out "$OUT/cell"
+"$BIN/surfinspect" demo-cell --out "$OUT/cell" --parts 3
 say "What the files hold"
 "$BIN/surfinspect" info "$OUT/cell/part.stl"
 "$BIN/surfinspect" info "$OUT/cell/gauge.stl"
-first_scan=$(ls "$OUT"/cell/scans/*.pcd | head -1)
-"$BIN/surfinspect" info "$first_scan"
+"$BIN/surfinspect" info "$OUT/cell/scans/part-001/v1.pcd"
