@@ -33,7 +33,7 @@ namespace {
 
 using namespace surfinspect;
 
-const LinkClusteringSettings kSettings;  // the defaults: 0.85 mm, 50 points
+const LinkClusteringSettings kSettings;  // the defaults: 0.5 mm, 50 points, 8 neighbours
 
 PointCloud DemoScan(uint32_t width, uint32_t height) {
   const DemoCell cell = MakeDemoCell();

@@ -1,5 +1,5 @@
 # Runs `surfinspect filter` as a user would, on an organized cloud it writes
-# itself: a 30 x 20 plane at 0.5 mm pitch with 3 no-data pixels, one pulse
+# itself: a 30 x 20 plane at 0.25 mm pitch with 3 no-data pixels, one pulse
 # (+10 mm) and a 2 x 2 patch lifted by 5 mm. With --min-cluster 10 exactly
 # those 5 points must go; the report, the filtered cloud and the PNG are
 # checked, and bad parameters must fail with a clear message.
@@ -9,10 +9,12 @@ file(MAKE_DIRECTORY ${WORK})
 set(points "")
 foreach(row RANGE 19)
   foreach(col RANGE 29)
-    math(EXPR xi "${col} / 2")
-    math(EXPR xf "${col} % 2 * 5")
-    math(EXPR yi "${row} / 2")
-    math(EXPR yf "${row} % 2 * 5")
+    math(EXPR xi "${col} / 4")
+    math(EXPR xf "${col} % 4 * 25 + 100")  # 100..175: the digits after "1"
+    math(EXPR yi "${row} / 4")
+    math(EXPR yf "${row} % 4 * 25 + 100")
+    string(SUBSTRING ${xf} 1 2 xf)
+    string(SUBSTRING ${yf} 1 2 yf)
     set(z 400)
     if(row EQUAL 5 AND col EQUAL 5)
       set(z 410)
@@ -38,7 +40,7 @@ endif()
 file(READ ${WORK}/report.json report)
 foreach(pair "input_points=600" "valid_points=597" "kept=592" "removed=5" "clusters=3"
              "largest_cluster=592" "parameters;min_cluster_points=10"
-             "parameters;connectivity=8" "parameters;link_distance_mm=0.85")
+             "parameters;connectivity=8" "parameters;link_distance_mm=0.5")
   string(REPLACE "=" ";" kv "${pair}")
   list(POP_BACK kv want)
   string(JSON got GET "${report}" ${kv})

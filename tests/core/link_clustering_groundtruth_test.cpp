@@ -79,54 +79,89 @@ Score ScoreFilter(const SimulatedScan& scan, const LinkClusteringResult& r) {
   return s;
 }
 
-TEST(LinkClusteringGroundTruth, DemoPartScansMeetTheIssueTargets) {
-  const DemoCell cell = MakeDemoCell();
-  const LinkClusteringSettings settings;  // the defaults are what is tested
-  Score total;
-  for (std::size_t v = 0; v < cell.viewpoints.size(); ++v) {
-    const DemoViewpoint& vp = cell.viewpoints[v];
-    ScanOptions opt;
-    opt.noise_sigma_mm = 0.015;
-    opt.pulse_fraction = 0.003;
-    opt.stripes = true;
-    opt.defects = PlantDefects(cell, vp);
-    opt.seed = 100 + v;
-    ASSERT_GE(opt.defects.size(), 3u) << vp.name;
-    auto scan = SimulateScan(cell.part, cell.world_from_part, vp.world_from_sensor,
-                             cell.intrinsics, opt);
-    ASSERT_TRUE(scan.ok()) << scan.status();
-    auto r = ClusterLinks(scan->cloud_in_sensor, settings);
-    ASSERT_TRUE(r.ok()) << r.status();
-    const Score s = ScoreFilter(*scan, *r);
-    std::cout << vp.name << ": " << s << ", clusters " << r->clusters.size() << "\n";
-    ASSERT_GT(s.pulses, 300u);
-    ASSERT_GT(s.stripes, 100u);
-    ASSERT_GT(s.defect, 1000u);
-    total.Add(s);
-
-    // Kept coordinates are bit-identical, removed ones are NaN, the grid stays.
-    auto out = ApplyFilter(scan->cloud_in_sensor, *r);
-    ASSERT_TRUE(out.ok());
-    ASSERT_EQ(out->width, scan->cloud_in_sensor.width);
-    ASSERT_EQ(out->height, scan->cloud_in_sensor.height);
-    std::size_t kept_valid = 0;
-    for (std::size_t i = 0; i < out->size(); ++i) {
-      if (r->kept_mask[i]) {
-        ++kept_valid;
-        ASSERT_EQ(0, std::memcmp(out->points[i].data(),
-                                 scan->cloud_in_sensor.points[i].data(), 12))
-            << "pixel " << i;
-      } else {
-        ASSERT_FALSE(PointCloud::IsValid(out->points[i])) << "pixel " << i;
-      }
+// The demo part from its five viewpoints with noise ~0.015 mm, 0.3% pulses,
+// stripes and five planted defects each, simulated once for all tests.
+class LinkClusteringGroundTruth : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    const DemoCell cell = MakeDemoCell();
+    scans_ = new std::vector<SimulatedScan>;
+    for (std::size_t v = 0; v < cell.viewpoints.size(); ++v) {
+      const DemoViewpoint& vp = cell.viewpoints[v];
+      ScanOptions opt;
+      opt.noise_sigma_mm = 0.015;
+      opt.pulse_fraction = 0.003;
+      opt.stripes = true;
+      opt.defects = PlantDefects(cell, vp);
+      opt.seed = 100 + v;
+      auto scan = SimulateScan(cell.part, cell.world_from_part, vp.world_from_sensor,
+                               cell.intrinsics, opt);
+      ASSERT_TRUE(scan.ok()) << scan.status();
+      scans_->push_back(*std::move(scan));
     }
-    EXPECT_EQ(kept_valid, r->kept);
   }
-  std::cout << "all: " << total << "\n";
+  static void TearDownTestSuite() { delete scans_; }
+
+  // Filters every scan; checks the per-scan sanity and the kept bits.
+  static Score FilterAll(const LinkClusteringSettings& settings) {
+    Score total;
+    LinkClusteringResult r;  // reused across views, as the pipeline does
+    for (std::size_t v = 0; v < scans_->size(); ++v) {
+      const SimulatedScan& scan = (*scans_)[v];
+      EXPECT_TRUE(ClusterLinksInto(scan.cloud_in_sensor, settings, r).ok());
+      const Score s = ScoreFilter(scan, r);
+      std::cout << "v" << v + 1 << ": " << s << ", clusters " << r.clusters.size() << "\n";
+      EXPECT_GT(s.pulses, 300u);
+      EXPECT_GT(s.stripes, 100u);
+      EXPECT_GT(s.defect, 1000u);
+      total.Add(s);
+
+      // Kept coordinates are bit-identical, removed ones NaN, the grid stays.
+      auto out = ApplyFilter(scan.cloud_in_sensor, r);
+      EXPECT_TRUE(out.ok());
+      if (!out.ok()) continue;
+      EXPECT_EQ(out->width, scan.cloud_in_sensor.width);
+      EXPECT_EQ(out->height, scan.cloud_in_sensor.height);
+      std::size_t kept_valid = 0, bad = 0;
+      for (std::size_t i = 0; i < out->size(); ++i) {
+        if (r.kept_mask[i]) {
+          ++kept_valid;
+          bad += std::memcmp(out->points[i].data(), scan.cloud_in_sensor.points[i].data(), 12) != 0;
+        } else {
+          bad += PointCloud::IsValid(out->points[i]);
+        }
+      }
+      EXPECT_EQ(bad, 0u);
+      EXPECT_EQ(kept_valid, r.kept);
+    }
+    std::cout << "all: " << total << "\n";
+    return total;
+  }
+
+  static std::vector<SimulatedScan>* scans_;
+};
+std::vector<SimulatedScan>* LinkClusteringGroundTruth::scans_ = nullptr;
+
+// The issue's targets, for scans that feed an error map.
+TEST_F(LinkClusteringGroundTruth, InspectionPresetMeetsTheIssueTargets) {
+  const Score total = FilterAll(LinkClusteringSettings::ForInspection());
   EXPECT_GE(total.pulse_recall(), 0.99) << total;
   EXPECT_GE(total.stripe_recall(), 0.95) << total;
   EXPECT_GE(total.good_kept_ratio(), 0.99) << total;
   EXPECT_GE(total.defect_kept_ratio(), 0.999) << total;
+}
+
+// The paper's defaults (0.5 mm) remove outliers more thoroughly, as
+// calibration wants, at the price of dent points on steep walls: measured
+// 99.6% kept, below the 99.9% an error map needs (hence ForInspection()).
+TEST_F(LinkClusteringGroundTruth, DefaultsRemoveOutliersMoreThoroughly) {
+  const Score defaults = FilterAll(LinkClusteringSettings{});
+  const Score inspection = FilterAll(LinkClusteringSettings::ForInspection());
+  EXPECT_GE(defaults.pulse_recall(), 0.99) << defaults;
+  EXPECT_GE(defaults.stripe_recall(), 0.995) << defaults;
+  EXPECT_GE(defaults.good_kept_ratio(), 0.99) << defaults;
+  EXPECT_GT(defaults.stripe_recall(), inspection.stripe_recall());
+  EXPECT_LT(defaults.defect_kept_ratio(), inspection.defect_kept_ratio());
 }
 
 }  // namespace
