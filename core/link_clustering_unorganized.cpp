@@ -173,7 +173,7 @@ absl::Status ClusterLinksUnorganized(const PointCloud& cloud,
   for (int dz = 0; dz <= 2; ++dz)
     for (int dy = dz == 0 ? 1 : -2; dy <= 2; ++dy)
       row_offset[rows++] = dz * step_z + dy * step_y;  // wraps only for dy < 0, dz > 0
-  uint32_t row_first[12] = {}, row_end[12] = {};
+  uint32_t row_first[12] = {};
   auto advance = [&](uint32_t& cursor, uint64_t first_key_not_before) {
     while (cursor < num_cells && s.key[cursor] < first_key_not_before) ++cursor;
   };
@@ -193,9 +193,9 @@ absl::Status ClusterLinksUnorganized(const PointCloud& cloud,
     };
     for (uint32_t b = a + 1; b < num_cells && s.key[b] <= key + 2; ++b) try_link(b);
     for (int k = 0; k < rows; ++k) {
-      advance(row_first[k], key + row_offset[k] - 2);
-      advance(row_end[k], key + row_offset[k] + 3);
-      for (uint32_t b = row_first[k]; b < row_end[k]; ++b) try_link(b);
+      const uint64_t first_key = key + row_offset[k] - 2, last_key = first_key + 4;
+      advance(row_first[k], first_key);
+      for (uint32_t b = row_first[k]; b < num_cells && s.key[b] <= last_key; ++b) try_link(b);
     }
   }
 
