@@ -10,8 +10,9 @@
 //    in the sensor grid may link; a run-based two-pass union-find over the
 //    grid, see link_clustering_grid.h;
 //  * unorganized (the general path): every pair within the link distance
-//    links, found with a hashed voxel grid whose cell edge equals the link
-//    distance (27 neighbouring cells), see link_clustering_unorganized.h.
+//    links, found with a sorted voxel grid (cells of edge d / sqrt(3), whose
+//    points are all linked), see link_clustering_unorganized.h.
+// Both give labels equal (up to renaming) to brute force; see the tests.
 #pragma once
 
 #include <Eigen/Core>
@@ -88,8 +89,9 @@ struct LinkClusteringResult {
 };
 
 // The link predicate both paths (and their tests) use, in float arithmetic
-// with a fixed summation order so every path decides identically. False
-// when either point holds NaN.
+// with a fixed order of operations so every path decides identically (the
+// SSE row kernels repeat it exactly; x86-64's baseline has no FMA to fuse
+// it). False when either point holds NaN.
 inline bool PointsLinked(const Eigen::Vector3f& a, const Eigen::Vector3f& b,
                          float link_distance_sq) {
   const float dx = a.x() - b.x(), dy = a.y() - b.y(), dz = a.z() - b.z();
