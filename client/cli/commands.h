@@ -28,5 +28,6 @@ T Take(absl::StatusOr<T> v) {
 void AddInfoCommand(CLI::App& app);
 void AddFilterCommand(CLI::App& app);
 void AddSimulateCommands(CLI::App& app);
+void AddErrorMapCommand(CLI::App& app);
 
 }  // namespace surfinspect::cli

@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   surfinspect::cli::AddInfoCommand(app);
   surfinspect::cli::AddFilterCommand(app);
   surfinspect::cli::AddSimulateCommands(app);
+  surfinspect::cli::AddErrorMapCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
