@@ -80,8 +80,13 @@ void AppendNumber(std::string& line, float v) {
   line.append(buf, res.ptr);
 }
 
+// JSON has no NaN: a missing number is null in the object itself, not only
+// once dumped, so the server's serialisation sees the same thing.
+nlohmann::json Num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
 nlohmann::json Stats(const ComponentStats& c) {
-  return {{"mean_mm", c.mean_mm}, {"rms_mm", c.rms_mm}, {"min_mm", c.min_mm}, {"max_mm", c.max_mm}};
+  return {{"mean_mm", Num(c.mean_mm)}, {"rms_mm", Num(c.rms_mm)}, {"min_mm", Num(c.min_mm)},
+          {"max_mm", Num(c.max_mm)}};
 }
 
 }  // namespace
@@ -165,7 +170,7 @@ nlohmann::json ErrorMapReportJson(const ErrorMapResult& r, const ErrorMapSetting
   j["units"] = "mm";
   j["sign"] = "+ above the CAD surface (side of the CCW face normals), - below";
   j["settings"] = {{"tolerance_mm", settings.tolerance_mm},
-                   {"max_distance_mm", settings.max_distance_mm},
+                   {"max_distance_mm", Num(settings.max_distance_mm)},  // null = unlimited
                    {"allowed_fraction_outside", settings.allowed_fraction_outside},
                    {"histogram_bins", settings.histogram_bins},
                    {"split_components", settings.split_components}};
@@ -173,17 +178,18 @@ nlohmann::json ErrorMapReportJson(const ErrorMapResult& r, const ErrorMapSetting
                  {"valid", s.valid},
                  {"matched", s.matched},
                  {"unmatched_valid", s.valid - s.matched}};
-  j["statistics"] = {{"min_mm", s.min_mm}, {"max_mm", s.max_mm},       {"mean_mm", s.mean_mm},
-                     {"stddev_mm", s.stddev_mm}, {"rms_mm", s.rms_mm}, {"p1_mm", s.p1_mm},
-                     {"p5_mm", s.p5_mm},   {"p50_mm", s.p50_mm},       {"p95_mm", s.p95_mm},
-                     {"p99_mm", s.p99_mm}};
+  j["statistics"] = {{"min_mm", Num(s.min_mm)},       {"max_mm", Num(s.max_mm)},
+                     {"mean_mm", Num(s.mean_mm)},     {"stddev_mm", Num(s.stddev_mm)},
+                     {"rms_mm", Num(s.rms_mm)},       {"p1_mm", Num(s.p1_mm)},
+                     {"p5_mm", Num(s.p5_mm)},         {"p50_mm", Num(s.p50_mm)},
+                     {"p95_mm", Num(s.p95_mm)},       {"p99_mm", Num(s.p99_mm)}};
   const Verdict& v = r.verdict;
   j["tolerance"] = {{"band_mm", r.tolerance_mm},
                     {"within", v.within},
                     {"above", v.above},
                     {"below", v.below},
-                    {"fraction_within", v.fraction_within},
-                    {"fraction_outside", v.fraction_outside},
+                    {"fraction_within", Num(v.fraction_within)},
+                    {"fraction_outside", Num(v.fraction_outside)},
                     {"allowed_fraction_outside", settings.allowed_fraction_outside},
                     {"verdict", v.pass ? "pass" : "fail"},
                     {"reason", v.reason}};

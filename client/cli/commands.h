@@ -32,5 +32,6 @@ void AddCalibrateCommand(CLI::App& app);
 void AddRegisterCommand(CLI::App& app);
 void AddInspectCommand(CLI::App& app);
 void AddHealthCommand(CLI::App& app);
+void AddErrorMapCommand(CLI::App& app);
 
 }  // namespace surfinspect::cli

@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   surfinspect::cli::AddRegisterCommand(app);
   surfinspect::cli::AddInspectCommand(app);
   surfinspect::cli::AddHealthCommand(app);
+  surfinspect::cli::AddErrorMapCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

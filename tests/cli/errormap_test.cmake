@@ -1,0 +1,52 @@
+# Runs `surfinspect errormap` on a plane, a 3 x 2 organized cloud (one NaN
+# pixel, one point beyond --max-distance) and a world_from_part shift of
+# 100 mm in x; checks the CSV row by row, the report, the PNG/PLY and the
+# verdict switch, and that bad input fails clearly.
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK})
+file(WRITE ${WORK}/plane.off "OFF\n4 2 0\n0 0 0\n10 0 0\n10 10 0\n0 10 0\n3 0 1 2\n3 0 2 3\n")
+file(WRITE ${WORK}/c.pcd "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\nHEIGHT 2\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 6\nDATA ascii\n102 2 0.05\n105 5 -0.2\nnan nan nan\n108 8 0\n103 7 9\n104 4 0.5\n")
+file(WRITE ${WORK}/t.json "{\"matrix\": [[1,0,0,100],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}")
+set(ARGS errormap --cloud ${WORK}/c.pcd --mesh ${WORK}/plane.off --world-from-part ${WORK}/t.json
+         --out ${WORK}/o.ply --csv ${WORK}/o.csv --report ${WORK}/o.json --png ${WORK}/o.png
+         --tolerance 0.1 --threads 2)
+execute_process(COMMAND ${CLI} ${ARGS} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "matched 4" OR NOT out MATCHES "verdict: fail")
+  message(FATAL_ERROR "errormap failed: ${rc}\n${out}\n${err}")
+endif()
+file(READ ${WORK}/o.csv csv)
+set(want "x,y,z,deviation\n2,2,0.05,0.05\n5,5,-0.2,-0.2\nnan,nan,nan,nan\n8,8,0,0\n3,7,9,nan\n4,4,0.5,0.5\n")
+if(NOT csv STREQUAL want)
+  message(FATAL_ERROR "CSV differs (part frame, input order, nan where unmatched):\n${csv}")
+endif()
+file(READ ${WORK}/o.json report)
+if(NOT report MATCHES "\"verdict\": \"fail\"" OR NOT report MATCHES "\"matched\": 4"
+   OR NOT report MATCHES "\"above\": 1" OR NOT report MATCHES "\"below\": 1")
+  message(FATAL_ERROR "report lacks the verdict or counts:\n${report}")
+endif()
+file(READ ${WORK}/o.ply ply LIMIT 400)
+if(NOT ply MATCHES "^ply\nformat binary_little_endian 1.0" OR NOT ply MATCHES "element vertex 5"
+   OR NOT ply MATCHES "property float deviation")
+  message(FATAL_ERROR "PLY header wrong:\n${ply}")
+endif()
+file(READ ${WORK}/o.png png LIMIT 4 HEX)
+if(NOT png STREQUAL "89504e47")
+  message(FATAL_ERROR "not a PNG: ${png}")
+endif()
+# Half the matched points are outside +-0.1: allowing 50% passes.
+execute_process(COMMAND ${CLI} ${ARGS} --allowed-outside 0.5 RESULT_VARIABLE rc OUTPUT_VARIABLE out)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "verdict: pass")
+  message(FATAL_ERROR "--allowed-outside 0.5 should pass: ${rc}\n${out}")
+endif()
+execute_process(COMMAND ${CLI} errormap --cloud ${WORK}/c.pcd --mesh ${WORK}/missing.stl --out ${WORK}/x.ply
+                RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(rc EQUAL 0 OR NOT err MATCHES "missing.stl")
+  message(FATAL_ERROR "a missing mesh must fail clearly: ${rc}\n${err}")
+endif()
+execute_process(COMMAND ${CLI} ${ARGS} --tolerance -1 RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(rc EQUAL 0)
+  message(FATAL_ERROR "a negative tolerance must be rejected")
+endif()
+if(EXISTS ${WORK}/x.ply)
+  message(FATAL_ERROR "a failed run must not leave an output file")
+endif()
