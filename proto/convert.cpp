@@ -115,6 +115,9 @@ void FilterStatsToProto(const LinkClusteringResult& r, v1::FilterStats* msg) {
   msg->set_removed(r.removed);
   msg->set_clusters(r.clusters.size());
   msg->set_largest_cluster(r.largest_cluster);
+  uint64_t removed_clusters = 0;
+  for (const ClusterInfo& k : r.clusters) removed_clusters += k.kept ? 0 : 1;
+  msg->set_removed_clusters(removed_clusters);
 }
 
 absl::StatusOr<IcpSettings> IcpSettingsFromProto(const v1::IcpSettings& msg, const std::string& field) {
