@@ -91,8 +91,9 @@ void MeshToProto(const TriangleMesh& mesh, v1::InlineMesh* msg) {
 }
 
 absl::StatusOr<LinkClusteringSettings> FilterSettingsFromProto(const v1::FilterSettings& msg,
-                                                               const std::string& field) {
-  LinkClusteringSettings s;
+                                                               const std::string& field,
+                                                               const LinkClusteringSettings& base) {
+  LinkClusteringSettings s = base;
   if (msg.has_link_distance_mm()) s.link_distance_mm = msg.link_distance_mm();
   if (msg.has_min_cluster_points()) s.min_cluster_points = msg.min_cluster_points();
   if (msg.has_connectivity()) s.connectivity = static_cast<int>(msg.connectivity());
