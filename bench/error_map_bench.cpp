@@ -186,6 +186,7 @@ void PrintSummary() {
               best("open3d/organized") / best("organized/coherent"),
               best("open3d/organized") / best("organized/plain"));
   // Agreement on the same points: ours is exact in double, Open3D is float32.
+  if (!g_best.count("open3d/shuffled")) return;  // Open3D was filtered out
   auto scene = Open3DScene();
   for (const bool organized : {false, true}) {
     const PointCloud& cloud = organized ? Get().organized : Get().shuffled;
