@@ -251,6 +251,8 @@ ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_dis
   return out;
 }
 
+absl::Status MeshIndex::TakeDeviceError() const { return device_->TakeError(); }
+
 std::size_t MeshIndex::memory_bytes() const {
   const int64_t embree = embree_bytes_ ? embree_bytes_->load(std::memory_order_relaxed) : 0;
   return sizeof(*this) + mesh_.vertices.capacity() * sizeof(Eigen::Vector3f) +

@@ -88,6 +88,11 @@ class MeshIndex {
   ClosestPoint Closest(const Eigen::Vector3d& p_in_mesh, double max_distance_mm = INFINITY,
                        uint32_t hint_triangle = UINT32_MAX) const;
 
+  // Embree reports failures through the device's error callback, not
+  // through rtcPointQuery: this returns (and clears) any error recorded
+  // since the last call. The batch queries check it when they finish.
+  absl::Status TakeDeviceError() const;
+
   const TriangleMesh& mesh() const { return mesh_; }
   const MeshIndexInfo& info() const { return info_; }
   // Mesh, pseudonormals and Embree's BVH (measured through Embree's memory

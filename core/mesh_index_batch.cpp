@@ -144,7 +144,7 @@ absl::Status QueryClosestEach(
                       });
   });
   if (cancelled.load()) return absl::CancelledError("closest-point query cancelled");
-  return absl::OkStatus();
+  return index.TakeDeviceError();
 }
 
 absl::StatusOr<std::vector<ClosestPoint>> QueryClosest(const MeshIndex& index,
