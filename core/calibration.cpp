@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
+#include "core/transform.h"
 
 namespace surfinspect {
 namespace {
@@ -38,6 +39,77 @@ double DegeneracyRatio(const IcpResult& icp) {
   return ev(5) > 0 ? std::max(0.0, ev(0)) / ev(5) : 0.0;
 }
 
+// Truncated cost of a pose: mean of min(d, cap)^2 over the sample.
+absl::StatusOr<double> TruncatedCost(const MeshIndex& gauge, const PointCloud& sample,
+                                     const Eigen::Isometry3d& gauge_from_sensor, double cap,
+                                     int threads, const std::atomic<bool>* cancel) {
+  BatchQuerySettings q;
+  q.max_distance_mm = cap;
+  q.threads = threads;
+  auto closest = QueryClosest(gauge, sample, gauge_from_sensor, q, cancel);
+  if (!closest.ok()) return closest.status();
+  double sum = 0;
+  for (const auto& c : *closest) sum += c.matched() ? c.distance_mm * c.distance_mm : cap * cap;
+  return sum / double(closest->size());
+}
+
+// The coarse search of CalibrationSettings: rotations about the sensor
+// origin (right-multiplied), the dominant part of a robot pose error, scored
+// by truncated cost; the best few are refined by a short point-to-plane ICP
+// on the same sample, and the lowest refined cost wins.
+absl::StatusOr<Eigen::Isometry3d> CoarseSearch(const MeshIndex& gauge, const PointCloud& scan,
+                                               const Eigen::Isometry3d& initial,
+                                               const CalibrationSettings& s,
+                                               const std::atomic<bool>* cancel) {
+  std::vector<Eigen::Vector3f> pts;
+  scan.ForEachValid([&](std::size_t, const Eigen::Vector3f& p) { pts.push_back(p); });
+  if (pts.size() > s.coarse_points) {
+    std::vector<Eigen::Vector3f> sub;
+    const double stride = double(pts.size()) / s.coarse_points;
+    for (std::size_t k = 0; k < s.coarse_points; ++k) sub.push_back(pts[std::size_t(k * stride)]);
+    pts.swap(sub);
+  }
+  const PointCloud sample = PointCloud::Unorganized(std::move(pts));
+  const int steps = static_cast<int>(std::floor(s.coarse_search_deg / s.coarse_step_deg + 1e-9));
+  const double cap = 10.0, d = s.coarse_step_deg * M_PI / 180;
+  std::vector<std::pair<double, Eigen::Isometry3d>> scored;
+  for (int i = -steps; i <= steps; ++i)
+    for (int j = -steps; j <= steps; ++j)
+      for (int k = -steps; k <= steps; ++k) {
+        Eigen::Isometry3d r = Eigen::Isometry3d::Identity();
+        r.linear() = (Eigen::AngleAxisd(i * d, Eigen::Vector3d::UnitX()) *
+                      Eigen::AngleAxisd(j * d, Eigen::Vector3d::UnitY()) *
+                      Eigen::AngleAxisd(k * d, Eigen::Vector3d::UnitZ()))
+                         .toRotationMatrix();
+        auto cost = TruncatedCost(gauge, sample, initial * r, cap, s.icp.threads, cancel);
+        if (!cost.ok()) return cost.status();
+        scored.emplace_back(*cost, initial * r);
+      }
+  const std::size_t keep = std::min<std::size_t>(6, scored.size());
+  std::partial_sort(scored.begin(), scored.begin() + keep, scored.end(),
+                    [](const auto& a, const auto& b) { return a.first < b.first; });
+  IcpSettings refine;
+  refine.step = IcpStep::kPointToPlane;
+  refine.max_iterations = 15;
+  refine.max_correspondence_mm = 2 * cap;
+  refine.max_points = 0;
+  refine.threads = s.icp.threads;
+  double best_value = INFINITY;
+  Eigen::Isometry3d best = initial;
+  for (std::size_t c = 0; c < keep; ++c) {
+    auto icp = RunIcp(gauge, sample, scored[c].second, refine, cancel);
+    if (icp.status().code() == absl::StatusCode::kCancelled) return icp.status();
+    if (!icp.ok()) continue;  // a hopeless candidate: too few pairs
+    auto cost = TruncatedCost(gauge, sample, icp->mesh_from_points, cap, s.icp.threads, cancel);
+    if (!cost.ok()) return cost.status();
+    if (*cost < best_value) {
+      best_value = *cost;
+      best = icp->mesh_from_points;
+    }
+  }
+  return best;
+}
+
 }  // namespace
 
 absl::StatusOr<CalibrationResult> CalibrateViewpoint(
@@ -46,6 +118,10 @@ absl::StatusOr<CalibrationResult> CalibrateViewpoint(
     const CalibrationSettings& s, const std::atomic<bool>* cancel) {
   if (!(s.degeneracy_threshold >= 0 && s.degeneracy_threshold < 1))
     return absl::InvalidArgumentError("calibration: degeneracy_threshold must be in [0, 1)");
+  if (!(s.coarse_search_deg >= 0 && s.coarse_search_deg <= 30) ||
+      (s.coarse_search_deg > 0 && !(s.coarse_step_deg >= 0.1)) || s.coarse_points < 10)
+    return absl::InvalidArgumentError(
+        "calibration: coarse_search_deg in [0, 30], coarse_step_deg >= 0.1, coarse_points >= 10");
   if (auto st = scan_in_sensor.Validate(); !st.ok()) return st;
   CalibrationResult r;
   r.scan_points = scan_in_sensor.CountValid();
@@ -61,8 +137,13 @@ absl::StatusOr<CalibrationResult> CalibrateViewpoint(
     scan = &filtered;
   }
 
-  const Eigen::Isometry3d initial_gauge_from_sensor =
-      world_from_gauge.inverse() * initial_world_from_sensor;
+  Eigen::Isometry3d initial_gauge_from_sensor = world_from_gauge.inverse() * initial_world_from_sensor;
+  if (s.coarse_search_deg > 0) {
+    auto coarse = CoarseSearch(gauge, *scan, initial_gauge_from_sensor, s, cancel);
+    if (!coarse.ok()) return coarse.status();
+    r.coarse_rotation_deg = ComparePoses(initial_gauge_from_sensor, *coarse).rotation_deg;
+    initial_gauge_from_sensor = *coarse;
+  }
   auto icp = RunIcp(gauge, *scan, initial_gauge_from_sensor, s.icp, cancel);
   if (!icp.ok()) return icp.status();
   r.icp = *std::move(icp);

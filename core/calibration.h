@@ -25,7 +25,24 @@ namespace surfinspect {
 struct CalibrationSettings {
   bool filter_outliers = true;      // link clustering before ICP (the paper's order)
   LinkClusteringSettings filter;
-  IcpSettings icp;
+  // Point-to-plane by default: on the demo gauge it converges in a few
+  // iterations and its covariance matches the observed error (tests). The
+  // paper's Horn step (IcpStep::kPointToPoint) is selectable; it stops on a
+  // flat cost a few µm from the optimum, so its σ is optimistic.
+  IcpSettings icp = [] {
+    IcpSettings s;
+    s.step = IcpStep::kPointToPlane;
+    return s;
+  }();
+  // Coarse search before ICP: the robot's nominal pose can be off by
+  // degrees, which at a 400 mm stand-off moves the gauge by tens of mm,
+  // beyond ICP's capture range. Rotations about the sensor origin on a grid
+  // of +-coarse_search_deg in coarse_step_deg steps (per axis) are scored by
+  // the truncated mean squared distance of a small subsample; ICP starts
+  // from the best. 0 = off.
+  double coarse_search_deg = 6.0;
+  double coarse_step_deg = 3.0;
+  std::size_t coarse_points = 1500;
   // Smallest / largest eigenvalue of the normal matrix, taken about the
   // points' centroid with rotations scaled by their RMS radius (so the ratio
   // is unit-free). Below this the fit is flagged as degenerate.
@@ -48,6 +65,7 @@ struct CalibrationResult {
   double sigma_rotation_deg = 0;     // 1-σ (RMS over the three axes) of the rotation
   double degeneracy_ratio = 0;       // see CalibrationSettings::degeneracy_threshold
   bool degenerate = false;
+  double coarse_rotation_deg = 0;    // rotation the coarse search applied to the guess
   std::vector<std::string> warnings;
 };
 

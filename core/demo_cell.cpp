@@ -270,7 +270,11 @@ absl::Status WriteDemoCell(const std::string& dir, const DemoCell& cell,
         {"horizontal_fov_deg", cell.intrinsics.horizontal_fov_deg},
         {"min_range_mm", cell.intrinsics.min_range_mm},
         {"max_range_mm", cell.intrinsics.max_range_mm}}},
-      {"viewpoints", views}};
+      {"viewpoints", views},
+      // Stamped sheet metal: +-0.3 mm, and 0.1% of the points may fall
+      // outside (unfiltered speckle at shadow edges) before a part fails.
+      {"tolerance_mm", 0.3},
+      {"error_map", {{"allowed_fraction_outside", 0.001}, {"max_distance_mm", 5.0}}}};
   if (auto st = WriteStringAtomically(dir + "/cell.json", cell_json.dump(2) + "\n"); !st.ok()) return st;
   return WriteStringAtomically(dir + "/truth/parts.json", nlohmann::json(parts).dump(2) + "\n");
 }

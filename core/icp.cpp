@@ -162,7 +162,7 @@ absl::StatusOr<IcpResult> RunIcp(const MeshIndex& mesh, const PointCloud& points
   IcpResult result;
   result.points_used = pts.size();
   Eigen::Isometry3d pose = initial;
-  double gate = s.max_correspondence_mm;
+  double gate = s.max_correspondence_mm, previous_gate = gate;
   for (int it = 0;; ++it) {
     if (cancel && cancel->load(std::memory_order_relaxed)) return absl::CancelledError("icp cancelled");
     auto pairs = Correspond(mesh, pts, pose, gate, s, cancel);
@@ -186,7 +186,10 @@ absl::StatusOr<IcpResult> RunIcp(const MeshIndex& mesh, const PointCloud& points
       const double delta = it >= 2 && h[it - 2] - h[it - 1] > 0 ? dec1 / (h[it - 2] - h[it - 1]) : -1;
       const bool rate_usable = delta >= 0 && delta < 1;
       const double remaining = rate_usable ? dec1 * delta / (1 - delta) : std::abs(dec1);
-      if (remaining <= s.relative_cost_tolerance * h[it]) {
+      // A step that no longer lowers the cost (with the gate unchanged, so
+      // the costs compare like with like) has reached the noise floor.
+      const bool stalled = dec1 <= 0 && gate == previous_gate;
+      if (stalled || (dec1 >= 0 && remaining <= s.relative_cost_tolerance * h[it])) {
         result.stop_reason = IcpStopReason::kRelativeChange;
         stop = true;
       }
@@ -209,6 +212,7 @@ absl::StatusOr<IcpResult> RunIcp(const MeshIndex& mesh, const PointCloud& points
     auto delta = Step(*pairs, s);
     if (!delta.ok()) return delta.status();
     pose = *delta * pose;
+    previous_gate = gate;
     gate = std::clamp(4.0 * result.rms_mm, s.min_correspondence_mm, s.max_correspondence_mm);
   }
 }

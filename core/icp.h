@@ -11,7 +11,8 @@
 //    geometric rate of the decrease, the cost still to be gained is
 //    (Δ_{i−1} − Δ_i)·δ/(1 − δ); stop when that is below
 //    `relative_cost_tolerance`·Δ_i (and, when δ is not a usable rate, when the
-//    plain relative change is below it);
+//    plain relative change is below it), or when a step no longer lowers
+//    the cost at all (the noise floor);
 //  - an absolute cost threshold (mean squared distance, mm²);
 //  - `max_iterations`.
 // The loop polls a cancellation flag every iteration (and the closest-point
@@ -40,12 +41,12 @@ struct IcpSettings {
   // Pairs farther apart than the gate are rejected. The gate starts at
   // `max_correspondence_mm` (must cover the initial pose error) and then
   // follows 4 x the previous RMS, never below `min_correspondence_mm`.
-  double max_correspondence_mm = 20.0;
-  double min_correspondence_mm = 0.5;
+  double max_correspondence_mm = 50.0;
+  double min_correspondence_mm = 2.0;
   double trim_fraction = 0.0;          // also drop this worst fraction of pairs
   RobustKernel kernel = RobustKernel::kNone;
   double kernel_scale_mm = 0.05;       // Huber threshold / Tukey cut-off
-  double relative_cost_tolerance = 1e-6;
+  double relative_cost_tolerance = 1e-4;  // remaining gain / cost (eq. (5) extrapolated)
   double absolute_cost_mm2 = 0.0;      // stop when the mean squared distance is below
   std::size_t max_points = 40000;      // random subsample (fixed seed); 0 = all points
   uint64_t seed = 1;

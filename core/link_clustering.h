@@ -7,12 +7,12 @@
 //
 // Two paths with the same semantics for "linked":
 //  * organized grid (the fast path for sensor data): only 4- or 8-neighbours
-//    in the sensor grid may link; a two-pass union-find over the grid
-//    (Wu, Otoo & Suzuki, "Optimizing two-pass connected-component labeling
-//    algorithms", 2009) with the parent forest stored in the label array;
+//    in the sensor grid may link; a run-based two-pass union-find over the
+//    grid, see link_clustering_grid.h;
 //  * unorganized (the general path): every pair within the link distance
-//    links, found with a hashed voxel grid whose cell edge equals the link
-//    distance (27 neighbouring cells), see link_clustering_unorganized.h.
+//    links, found with a sorted voxel grid (cells of edge d / sqrt(3), whose
+//    points are all linked), see link_clustering_unorganized.h.
+// Both give labels equal (up to renaming) to brute force; see the tests.
 #pragma once
 
 #include <Eigen/Core>
@@ -27,20 +27,40 @@
 
 namespace surfinspect {
 
+// The defaults are the paper's: they remove every outlier and may drop some
+// good points, which is right before ICP (paper §III: fewer good points "will
+// not change the calibration accuracy"). Before an error map, where dents
+// must survive, use ForInspection(). Both measured on simulated demo scans,
+// see tests/core/link_clustering_groundtruth_test.cpp.
 struct LinkClusteringSettings {
   // Two points link when |p - q| <= link_distance_mm (mm, finite, > 0). The
-  // paper uses 0.1-0.5 mm "according to the resolution of area sensors".
+  // paper sets it "according to the resolution of area sensors", 0.1-0.5 mm.
   double link_distance_mm = 0.5;
-  // Components with fewer valid points than this are outliers. The paper
-  // uses the class size as the criterion; 50 points is ~3 mm^2 of surface
-  // at the demo sensor's ~0.25 mm pixel pitch, far above pulse and stripe
-  // sizes and far below any real surface patch.
+  // Components with fewer valid points than this are outliers (the paper's
+  // class-size criterion). 50 points is ~3 mm^2 of surface at 0.25 mm pitch:
+  // far above a pulse (1 point) or a stripe chain (2-6 points per chain),
+  // far below any surface patch worth inspecting.
   uint32_t min_cluster_points = 50;
   // Grid path only: 4 or 8 neighbours.
   int connectivity = 8;
   // Also an outlier: a component with fewer than this fraction of the
   // largest component's points. In [0, 1]; 0 = off.
   double min_fraction_of_largest = 0.0;
+
+  // For scans that feed an error map. The demo sensor (1024 px over 35 deg)
+  // has a 0.25 mm pitch at 400 mm, but pitch / cos(incidence) on steep
+  // walls: at 0.5 mm those break into row fragments below 50 points, and
+  // 0.3-0.4% of the dent points go. 0.85 mm links surfaces seen at up to
+  // ~73 deg and stays below the >= 1 mm gap of mixed (stripe) pixels from
+  // the near surface: >= 99.9% of dent points kept, ~1% of stripe points
+  // too (linked to the far surface), which is why it is not the default:
+  // before calibration those cost accuracy (measured on the demo gauge
+  // scans: worst translation error ~10 um at 0.5 mm, ~50 um at 0.85 mm).
+  static LinkClusteringSettings ForInspection() {
+    LinkClusteringSettings s;
+    s.link_distance_mm = 0.85;
+    return s;
+  }
 };
 
 struct ClusterInfo {
@@ -69,8 +89,9 @@ struct LinkClusteringResult {
 };
 
 // The link predicate both paths (and their tests) use, in float arithmetic
-// with a fixed summation order so every path decides identically. False
-// when either point holds NaN.
+// with a fixed order of operations so every path decides identically (the
+// SSE row kernels repeat it exactly; x86-64's baseline has no FMA to fuse
+// it). False when either point holds NaN.
 inline bool PointsLinked(const Eigen::Vector3f& a, const Eigen::Vector3f& b,
                          float link_distance_sq) {
   const float dx = a.x() - b.x(), dy = a.y() - b.y(), dz = a.z() - b.z();
@@ -99,12 +120,6 @@ absl::Status ClusterLinksInto(const PointCloud& cloud,
                               LinkClusteringResult& result,
                               const std::atomic<bool>* cancel = nullptr);
 
-// Grid path on an organized cloud (also accepts height == 1 as one row).
-absl::Status ClusterLinksOrganized(const PointCloud& cloud,
-                                   const LinkClusteringSettings& settings,
-                                   LinkClusteringResult& result,
-                                   const std::atomic<bool>* cancel = nullptr);
-
 // The same cloud with every removed point set to NaN: an organized grid
 // stays the same grid, and kept (and no-data) points are copied bit for bit.
 // InvalidArgument when `result` does not cover this cloud (size mismatch).
@@ -112,9 +127,11 @@ absl::StatusOr<PointCloud> ApplyFilter(const PointCloud& cloud,
                                        const LinkClusteringResult& result);
 
 namespace internal {
-// Shared by both paths once labels and sizes are known: decides `kept` per
-// cluster and fills kept_mask and the counts.
-void DecideKept(const LinkClusteringSettings& settings, LinkClusteringResult& result);
+// Shared by both paths once the clusters and their sizes are known: decides
+// `kept` per cluster and fills the counts (not the mask).
+void DecideClusters(const LinkClusteringSettings& settings, LinkClusteringResult& result);
+// kept_mask from labels and the clusters' `kept` flags, point by point.
+void FillKeptMaskFromLabels(LinkClusteringResult& result);
 // Settings, emptiness and width * height checks shared by both paths (each
 // path rejects infinite coordinates during its own first pass).
 absl::Status CheckInput(const PointCloud& cloud, const LinkClusteringSettings& settings);

@@ -46,7 +46,7 @@ void RadixSort(std::vector<uint64_t>& keys, std::vector<uint32_t>& values, int k
   }
 }
 
-// Union-find over sorted positions; path halving, union by smaller index.
+// Union-find over cells; path halving, the smaller index becomes the root.
 struct Forest {
   std::vector<int32_t> parent;
   int32_t Find(int32_t i) {
@@ -58,28 +58,23 @@ struct Forest {
   }
 };
 
-// The sorted points as structure-of-arrays, for cache-friendly pair tests.
-struct SortedPoints {
-  std::vector<float> x, y, z;
-  std::vector<uint64_t> key;
+// The valid points sorted by cell, as structure-of-arrays, and the cells.
+struct SortedCells {
+  std::vector<float> x, y, z;     // per sorted position
+  std::vector<uint64_t> key;      // per cell, ascending
+  std::vector<uint32_t> begin;    // per cell: first sorted position; + end sentinel
+  std::vector<uint32_t> cell_of;  // per sorted position
 };
 
-// Tests point a against the sorted positions [b0, b1) and merges the links.
-void LinkRange(const SortedPoints& s, int32_t a, std::size_t b0, std::size_t b1, float r2,
-               Forest& forest) {
-  const Eigen::Vector3f pa(s.x[a], s.y[a], s.z[a]);
-  int32_t ra = forest.Find(a);
-  for (std::size_t b = b0; b < b1; ++b) {
-    if (!PointsLinked(pa, Eigen::Vector3f(s.x[b], s.y[b], s.z[b]), r2)) continue;
-    const int32_t rb = forest.Find(static_cast<int32_t>(b));
-    if (rb == ra) continue;
-    if (ra < rb) {
-      forest.parent[rb] = ra;
-    } else {
-      forest.parent[ra] = rb;
-      ra = rb;
-    }
+// Whether some point of cell a links to some point of cell b (the first
+// link found ends the search: one link merges the two cells).
+bool AnyLinked(const SortedCells& s, uint32_t a, uint32_t b, float r2) {
+  for (uint32_t i = s.begin[a]; i < s.begin[a + 1]; ++i) {
+    const Eigen::Vector3f p(s.x[i], s.y[i], s.z[i]);
+    for (uint32_t j = s.begin[b]; j < s.begin[b + 1]; ++j)
+      if (PointsLinked(p, Eigen::Vector3f(s.x[j], s.y[j], s.z[j]), r2)) return true;
   }
+  return false;
 }
 
 }  // namespace
@@ -109,18 +104,20 @@ absl::Status ClusterLinksUnorganized(const PointCloud& cloud,
           absl::StrCat("link clustering: point ", i, " has an infinite coordinate"));
     }
   }
-  // The cell is a hair larger than the link distance so float rounding in
-  // PointsLinked can never link two points whose cells are 2 apart.
-  const double cell = settings.link_distance_mm * (1.0 + 1e-5);
+  // Cells of edge d / sqrt(3), shrunk by 1e-4 so that float rounding in
+  // PointsLinked can never fail to link two points of the same cell (their
+  // true distance is < 0.9999 d; the float error is ~1e-7 relative).
+  const double cell = settings.link_distance_mm / std::sqrt(3.0) * (1.0 - 1e-4);
   int bits[3] = {0, 0, 0};
   for (int a = 0; m > 0 && a < 3; ++a) {
-    // Cell coordinates start at 1 so that x-1 and y-1 never borrow across
-    // key fields, and stop 1 below the field's top so that x+1 fits.
-    const double cells = std::floor((hi[a] - lo[a]) / cell) + 3.0;
+    // Cell coordinates start at 2 so that x-2 and y-2 never borrow across
+    // key fields, and stop 2 below the field's top so that x+2 fits.
+    const double cells = std::floor((hi[a] - lo[a]) / cell) + 5.0;
     if (!(cells < static_cast<double>(uint64_t{1} << kMaxAxisBits)))
       return absl::InvalidArgumentError(absl::StrCat(
           "link clustering: the cloud spans ", hi[a] - lo[a], " mm on axis ", a,
-          ", more than 2^21 link distances of ", settings.link_distance_mm, " mm"));
+          ", more than 2^21 cells for a link distance of ", settings.link_distance_mm,
+          " mm"));
     bits[a] = BitsFor(static_cast<uint64_t>(cells) - 1);
   }
 
@@ -133,66 +130,84 @@ absl::Status ClusterLinksUnorganized(const PointCloud& cloud,
     if (!PointCloud::IsValid(p)) continue;
     uint64_t c[3];
     for (int a = 0; a < 3; ++a)
-      c[a] = static_cast<uint64_t>(std::floor((p[a] - lo[a]) / cell)) + 1;
+      c[a] = static_cast<uint64_t>(std::floor((p[a] - lo[a]) / cell)) + 2;
     keys.push_back(c[0] | (c[1] << bits[0]) | (c[2] << (bits[0] + bits[1])));
     order.push_back(static_cast<uint32_t>(i));
   }
   if (cancelled()) return absl::CancelledError("link clustering: cancelled");
   RadixSort(keys, order, bits[0] + bits[1] + bits[2]);
 
-  SortedPoints s;
+  SortedCells s;
   s.x.resize(m);
   s.y.resize(m);
   s.z.resize(m);
+  s.cell_of.resize(m);
   for (std::size_t k = 0; k < m; ++k) {
+    // A gather in cell order: random reads of an unorganized cloud, so the
+    // point needed 16 steps later is requested now.
+    if (k + 16 < m) __builtin_prefetch(&cloud.points[order[k + 16]]);
     const Eigen::Vector3f& p = cloud.points[order[k]];
     s.x[k] = p.x();
     s.y[k] = p.y();
     s.z[k] = p.z();
+    if (k == 0 || keys[k] != keys[k - 1]) {
+      s.key.push_back(keys[k]);
+      s.begin.push_back(static_cast<uint32_t>(k));
+    }
+    s.cell_of[k] = static_cast<uint32_t>(s.key.size() - 1);
   }
-  s.key = std::move(keys);
+  const auto num_cells = static_cast<uint32_t>(s.key.size());
+  s.begin.push_back(static_cast<uint32_t>(m));
 
   Forest forest;
-  forest.parent.resize(m);
+  forest.parent.resize(num_cells);
   std::iota(forest.parent.begin(), forest.parent.end(), 0);
   const float r2 = LinkDistanceSquared(settings.link_distance_mm);
   const uint64_t step_y = uint64_t{1} << bits[0];
   const uint64_t step_z = uint64_t{1} << (bits[0] + bits[1]);
-  // Rows (dy, dz) of forward neighbours whose x-1..x+1 cells are one run.
-  const uint64_t row_offset[4] = {step_y, step_z - step_y, step_z, step_z + step_y};
-  std::size_t row_begin[4] = {0, 0, 0, 0}, row_end[4] = {0, 0, 0, 0};
-  std::size_t same_row_end = 0;
-  auto advance = [&](std::size_t& cursor, uint64_t first_key_not_before) {
-    while (cursor < m && s.key[cursor] < first_key_not_before) ++cursor;
+  // Forward neighbour rows (dy, dz) whose cells x-2..x+2 are one key range:
+  // dz = 0 with dy = 1, 2, and dz = 1, 2 with dy = -2..2. The cells x+1 and
+  // x+2 of the cell's own row follow it directly in the sorted order.
+  uint64_t row_offset[12];
+  int rows = 0;
+  for (int dz = 0; dz <= 2; ++dz)
+    for (int dy = dz == 0 ? 1 : -2; dy <= 2; ++dy)
+      row_offset[rows++] = dz * step_z + dy * step_y;  // wraps only for dy < 0, dz > 0
+  uint32_t row_first[12] = {};
+  auto advance = [&](uint32_t& cursor, uint64_t first_key_not_before) {
+    while (cursor < num_cells && s.key[cursor] < first_key_not_before) ++cursor;
   };
-  std::size_t cells_done = 0;
-  for (std::size_t begin = 0; begin < m;) {
-    if ((++cells_done & 4095) == 0 && cancelled())
-      return absl::CancelledError("link clustering: cancelled");
-    const uint64_t key = s.key[begin];
-    std::size_t end = begin;
-    while (end < m && s.key[end] == key) ++end;
-    advance(same_row_end, key + 2);  // this cell and x+1
-    for (int k = 0; k < 4; ++k) {
-      advance(row_begin[k], key + row_offset[k] - 1);
-      advance(row_end[k], key + row_offset[k] + 2);
+  for (uint32_t a = 0; a < num_cells; ++a) {
+    if ((a & 4095) == 0 && cancelled()) return absl::CancelledError("link clustering: cancelled");
+    const uint64_t key = s.key[a];
+    int32_t root_a = forest.Find(static_cast<int32_t>(a));
+    auto try_link = [&](uint32_t b) {
+      const int32_t root_b = forest.Find(static_cast<int32_t>(b));
+      if (root_b == root_a || !AnyLinked(s, a, b, r2)) return;
+      if (root_a < root_b) {
+        forest.parent[root_b] = root_a;
+      } else {
+        forest.parent[root_a] = root_b;
+        root_a = root_b;
+      }
+    };
+    for (uint32_t b = a + 1; b < num_cells && s.key[b] <= key + 2; ++b) try_link(b);
+    for (int k = 0; k < rows; ++k) {
+      const uint64_t first_key = key + row_offset[k] - 2, last_key = first_key + 4;
+      advance(row_first[k], first_key);
+      for (uint32_t b = row_first[k]; b < num_cells && s.key[b] <= last_key; ++b) try_link(b);
     }
-    for (std::size_t a = begin; a < end; ++a) {
-      const auto ai = static_cast<int32_t>(a);
-      LinkRange(s, ai, a + 1, same_row_end, r2, forest);
-      for (int k = 0; k < 4; ++k) LinkRange(s, ai, row_begin[k], row_end[k], r2, forest);
-    }
-    begin = end;
   }
 
-  // Ids in order of each component's first point index, with statistics.
-  std::vector<int32_t> position_of(n, kInvalid);
-  for (std::size_t k = 0; k < m; ++k) position_of[order[k]] = static_cast<int32_t>(k);
-  std::vector<int32_t> id_of_root(m, kInvalid);
+  // Each point's root cell, found in cell order (local) and scattered to
+  // the point's index; then ids in order of each component's first point
+  // index, with statistics.
+  for (std::size_t k = 0; k < m; ++k)
+    result.labels[order[k]] = forest.Find(static_cast<int32_t>(s.cell_of[k]));
+  std::vector<int32_t> id_of_root(num_cells, kInvalid);
   for (std::size_t i = 0; i < n; ++i) {
-    if (position_of[i] == kInvalid) continue;
-    const int32_t root = forest.Find(position_of[i]);
-    int32_t& id = id_of_root[root];
+    if (result.labels[i] == kInvalid) continue;
+    int32_t& id = id_of_root[result.labels[i]];
     const Eigen::Vector3f& p = cloud.points[i];
     const auto col = static_cast<uint32_t>(i);
     if (id == kInvalid) {
@@ -209,7 +224,8 @@ absl::Status ClusterLinksUnorganized(const PointCloud& cloud,
     k.max = k.max.cwiseMax(p);
     result.labels[i] = id;
   }
-  internal::DecideKept(settings, result);
+  internal::DecideClusters(settings, result);
+  internal::FillKeptMaskFromLabels(result);
   return absl::OkStatus();
 }
 

@@ -6,7 +6,6 @@
 #include <array>
 #include <cctype>
 #include <csetjmp>
-#include <cstdio>
 #include <map>
 
 #include "absl/strings/str_cat.h"
@@ -69,38 +68,45 @@ void RgbImage::DrawText(int x, int y, const std::string& text, Rgb c, int scale)
   }
 }
 
-absl::Status WritePng(const std::string& path, const RgbImage& image) {
+namespace {
+void AppendToString(png_structp png, png_bytep data, png_size_t length) {
+  static_cast<std::string*>(png_get_io_ptr(png))->append(reinterpret_cast<const char*>(data), length);
+}
+void NoFlush(png_structp) {}
+}  // namespace
+
+absl::StatusOr<std::string> EncodePng(const RgbImage& image) {
   if (image.width == 0 || image.height == 0 ||
       image.pixels.size() != std::size_t{image.width} * image.height)
-    return absl::InvalidArgumentError(absl::StrCat(path, ": image has no pixels"));
-  return WriteFileAtomically(path, [&](const std::string& tmp) -> absl::Status {
-    std::FILE* f = std::fopen(tmp.c_str(), "wb");
-    if (!f) return absl::PermissionDeniedError(absl::StrCat("cannot create ", tmp));
-    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
-    png_infop info = png ? png_create_info_struct(png) : nullptr;
-    if (!png || !info) {
-      png_destroy_write_struct(&png, &info);
-      std::fclose(f);
-      return absl::ResourceExhaustedError("libpng: out of memory");
-    }
-    // libpng reports errors by longjmp; nothing with a destructor lives
-    // between here and the end of the write.
-    if (setjmp(png_jmpbuf(png))) {
-      png_destroy_write_struct(&png, &info);
-      std::fclose(f);
-      return absl::InternalError(absl::StrCat(path, ": libpng write error"));
-    }
-    png_init_io(png, f);
-    png_set_IHDR(png, info, image.width, image.height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
-                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-    png_write_info(png, info);
-    for (uint32_t y = 0; y < image.height; ++y)
-      png_write_row(png, reinterpret_cast<png_const_bytep>(&image.pixels[std::size_t{y} * image.width]));
-    png_write_end(png, nullptr);
+    return absl::InvalidArgumentError("png: image has no pixels");
+  std::string out;
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  png_infop info = png ? png_create_info_struct(png) : nullptr;
+  if (!png || !info) {
     png_destroy_write_struct(&png, &info);
-    return std::fclose(f) == 0 ? absl::OkStatus()
-                               : absl::DataLossError(absl::StrCat("short write to ", tmp));
-  });
+    return absl::ResourceExhaustedError("libpng: out of memory");
+  }
+  // libpng reports errors by longjmp; nothing with a destructor is created
+  // between here and the end of the write (`out` exists before setjmp).
+  if (setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    return absl::InternalError("libpng: write error");
+  }
+  png_set_write_fn(png, &out, &AppendToString, &NoFlush);
+  png_set_IHDR(png, info, image.width, image.height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_write_info(png, info);
+  for (uint32_t y = 0; y < image.height; ++y)
+    png_write_row(png, reinterpret_cast<png_const_bytep>(&image.pixels[std::size_t{y} * image.width]));
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  return out;
+}
+
+absl::Status WritePng(const std::string& path, const RgbImage& image) {
+  auto bytes = EncodePng(image);
+  if (!bytes.ok()) return absl::Status(bytes.status().code(), absl::StrCat(path, ": ", bytes.status().message()));
+  return WriteStringAtomically(path, *bytes);
 }
 
 }  // namespace surfinspect

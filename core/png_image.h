@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "absl/status/status.h"
+#include "absl/status/statusor.h"
 
 namespace surfinspect {
 
@@ -33,6 +34,9 @@ struct RgbImage {
   void DrawText(int x, int y, const std::string& text, Rgb c, int scale = 1);
 };
 
+// The PNG bytes in memory (for RPC responses), and the same written to a
+// file atomically.
+absl::StatusOr<std::string> EncodePng(const RgbImage& image);
 absl::Status WritePng(const std::string& path, const RgbImage& image);
 
 }  // namespace surfinspect

@@ -36,7 +36,10 @@ absl::StatusOr<Eigen::Isometry3d> FromRowMajor(const RowMajor16& v,
         what, ": upper-left 3x3 is not a rotation (|R^T R - I| = ", ortho_error,
         ", det = ", r.determinant(), ")"));
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-  t.linear() = Eigen::Quaterniond(r).normalized().toRotationMatrix();
+  // Re-orthonormalise only what needs it: a matrix that is already a
+  // rotation to rounding keeps its exact bits (so a transform survives
+  // file and wire round trips unchanged).
+  t.linear() = ortho_error > 1e-12 ? Eigen::Quaterniond(r).normalized().toRotationMatrix() : r;
   t.translation() = m.topRightCorner<3, 1>();
   return t;
 }

@@ -17,9 +17,9 @@ using RowMajor16 = std::array<double, 16>;
 RowMajor16 ToRowMajor(const Eigen::Isometry3d& t);
 
 // Accepts a 4x4 whose upper-left 3x3 is a rotation to within 1e-6 (R^T R = I,
-// det = +1), whose last row is 0 0 0 1 and whose entries are finite. The
-// rotation is re-orthonormalised so tiny rounding in files does not
-// accumulate. `what` names the transform in the error message.
+// det = +1), whose last row is 0 0 0 1 and whose entries are finite. A
+// rotation off by more than 1e-12 (e.g. printed with few digits) is
+// re-orthonormalised; otherwise the matrix is kept bit for bit. `what` names the transform in the error message.
 absl::StatusOr<Eigen::Isometry3d> FromRowMajor(const RowMajor16& m,
                                                absl::string_view what);
 

@@ -28,6 +28,10 @@ T Take(absl::StatusOr<T> v) {
 void AddInfoCommand(CLI::App& app);
 void AddFilterCommand(CLI::App& app);
 void AddSimulateCommands(CLI::App& app);
+void AddCalibrateCommand(CLI::App& app);
+void AddRegisterCommand(CLI::App& app);
+void AddInspectCommand(CLI::App& app);
+void AddHealthCommand(CLI::App& app);
 void AddErrorMapCommand(CLI::App& app);
 
 }  // namespace surfinspect::cli

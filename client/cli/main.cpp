@@ -16,6 +16,10 @@ int main(int argc, char** argv) {
   surfinspect::cli::AddInfoCommand(app);
   surfinspect::cli::AddFilterCommand(app);
   surfinspect::cli::AddSimulateCommands(app);
+  surfinspect::cli::AddCalibrateCommand(app);
+  surfinspect::cli::AddRegisterCommand(app);
+  surfinspect::cli::AddInspectCommand(app);
+  surfinspect::cli::AddHealthCommand(app);
   surfinspect::cli::AddErrorMapCommand(app);
   try {
     app.parse(argc, argv);

@@ -7,12 +7,20 @@
 #include <queue>
 #include <random>
 
+#include "core/link_clustering_grid.h"
 #include "core/link_clustering_unorganized.h"
 
 namespace surfinspect {
 namespace {
 
 constexpr int32_t kInvalid = LinkClusteringResult::kInvalid;
+
+// The random inputs below are scaled for a 0.5 mm link distance.
+LinkClusteringSettings HalfMm() {
+  LinkClusteringSettings s;
+  s.link_distance_mm = 0.5;
+  return s;
+}
 
 // Brute-force oracle for the grid: BFS from every unvisited valid pixel over
 // the 4 or 8 grid neighbours, linking with the same predicate.
@@ -170,7 +178,7 @@ TEST(LinkClusteringGrid, MatchesBfsOracleOnRandomGrids) {
     const uint32_t w = size(rng) - 1, h = size(rng);  // w may be 1
     const PointCloud c = RandomGrid(rng, w, h, trial % 4 == 0 ? 0.0 : 0.2);
     for (int conn : {4, 8}) {
-      LinkClusteringSettings s;
+      LinkClusteringSettings s = HalfMm();
       s.connectivity = conn;
       s.min_cluster_points = 1 + trial % 7;
       s.min_fraction_of_largest = trial % 3 == 0 ? 0.1 : 0.0;
@@ -179,6 +187,35 @@ TEST(LinkClusteringGrid, MatchesBfsOracleOnRandomGrids) {
       EXPECT_TRUE(r->organized_path);
       SCOPED_TRACE(testing::Message() << "trial " << trial << " " << w << "x" << h << " conn "
                                       << conn);
+      ExpectSamePartition(r->labels, GridOracle(c, conn, LinkDistanceSquared(0.5)));
+      ExpectConsistent(c, *r, s);
+      if (HasFatalFailure()) return;
+    }
+  }
+}
+
+TEST(LinkClusteringGrid, WideGridsCrossMaskWords) {
+  // Rows wider than 64 pixels span several 64-bit link masks; runs and
+  // links must carry across the word boundaries. Smooth heights make long
+  // runs, so many of them cross a boundary.
+  std::mt19937 rng(17);
+  std::uniform_int_distribution<uint32_t> width(60, 300), height(2, 12);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  for (int trial = 0; trial < 60; ++trial) {
+    const uint32_t w = width(rng), h = height(rng);
+    PointCloud c = trial % 2 ? RandomGrid(rng, w, h, 0.05) : PointCloud::Organized(w, h);
+    if (trial % 2 == 0)
+      for (uint32_t r = 0; r < h; ++r)
+        for (uint32_t col = 0; col < w; ++col)
+          if (u(rng) > 0.02f)
+            c.points[r * w + col] = {0.3f * col, 0.3f * r, u(rng) < 0.03f ? 3.f : 0.1f * u(rng)};
+    for (int conn : {4, 8}) {
+      LinkClusteringSettings s = HalfMm();
+      s.connectivity = conn;
+      s.min_cluster_points = 3;
+      auto r = ClusterLinks(c, s);
+      ASSERT_TRUE(r.ok());
+      SCOPED_TRACE(testing::Message() << "trial " << trial << " " << w << "x" << h);
       ExpectSamePartition(r->labels, GridOracle(c, conn, LinkDistanceSquared(0.5)));
       ExpectConsistent(c, *r, s);
       if (HasFatalFailure()) return;
@@ -198,7 +235,7 @@ TEST(LinkClusteringGrid, SnakesAndSpiralsNeedManyMerges) {
         const bool on = (col % 2 == 0) || (r == (col % 4 == 1 ? h - 1 : 0));
         c.points[r * w + col] = {0.3f * col, 0.3f * r, on ? 0.f : 5.f + 7.f * ((r + col) % 2)};
       }
-    LinkClusteringSettings s;
+    LinkClusteringSettings s = HalfMm();
     s.connectivity = conn;
     auto r = ClusterLinks(c, s);
     ASSERT_TRUE(r.ok());
@@ -212,9 +249,9 @@ TEST(LinkClusteringGrid, SingleRowAndSingleColumn) {
   for (auto [w, h] : {std::pair<uint32_t, uint32_t>{50, 1}, {1, 50}, {1, 2}}) {
     const PointCloud c = RandomGrid(rng, w, h, 0.1);
     LinkClusteringResult r;
-    ASSERT_TRUE(ClusterLinksOrganized(c, {}, r).ok());
+    ASSERT_TRUE(ClusterLinksOrganized(c, HalfMm(), r).ok());
     ExpectSamePartition(r.labels, GridOracle(c, 8, LinkDistanceSquared(0.5)));
-    ExpectConsistent(c, r, {});
+    ExpectConsistent(c, r, HalfMm());
   }
 }
 
@@ -242,7 +279,7 @@ TEST(LinkClusteringUnorganized, MatchesPairwiseOracle) {
   std::uniform_int_distribution<std::size_t> size(1, 400);
   for (int trial = 0; trial < 150; ++trial) {
     LinkClusteringSettings s;
-    s.link_distance_mm = trial % 2 ? 0.5 : 0.37;
+    s.link_distance_mm = trial % 2 ? 0.85 : 0.37;
     s.min_cluster_points = 1 + trial % 5;
     s.min_fraction_of_largest = trial % 3 == 0 ? 0.2 : 0.0;
     const PointCloud c = RandomCloud(rng, size(rng), static_cast<float>(s.link_distance_mm));
@@ -257,16 +294,39 @@ TEST(LinkClusteringUnorganized, MatchesPairwiseOracle) {
 }
 
 TEST(LinkClusteringUnorganized, FloatRoundingAtCellBordersStillLinks) {
-  // Found by search: PointsLinked (float) links a and b, but with cells of
-  // exactly 0.5 mm from the origin lo their cells would be 2 apart.
+  // Found by search: PointsLinked (float) links a and b, but in a grid of
+  // cells of exactly 0.5 mm from the origin lo their cells would be 2 apart
+  // (a float-rounding trap for any voxel scheme).
   const float lo = -255.444946f, a = 0.555053711f, b = 0.0550536998f;
   ASSERT_TRUE(PointsLinked({a, 0, 0}, {b, 0, 0}, LinkDistanceSquared(0.5)));
   ASSERT_EQ(std::floor((double{a} - lo) / 0.5) - std::floor((double{b} - lo) / 0.5), 2.0);
   const PointCloud c = PointCloud::Unorganized({{lo, 0, 0}, {a, 0, 0}, {b, 0, 0}});
-  auto r = ClusterLinks(c, {});
+  auto r = ClusterLinks(c, HalfMm());
   ASSERT_TRUE(r.ok());
   EXPECT_EQ(r->labels[1], r->labels[2]);
   EXPECT_EQ(r->clusters.size(), 2u);
+}
+
+TEST(LinkClusteringUnorganized, CellDiagonalsJustBeyondTheLinkDistanceDoNotLink) {
+  // Points of one voxel cell are linked without a test, so no cell may hold
+  // two points farther apart than the link distance: pairs along the cell
+  // diagonal at d (1 +- delta) must link exactly when PointsLinked says so.
+  for (double d : {0.37, 0.5, 0.85, 1.3})
+    for (double delta : {-1e-3, -1e-4, 1e-4, 1e-3})
+      for (int signs = 0; signs < 8; ++signs) {
+        LinkClusteringSettings s;
+        s.link_distance_mm = d;
+        s.min_cluster_points = 1;
+        const Eigen::Vector3f a(1.5f, -0.75f, 2.25f);  // small: float keeps delta
+        const Eigen::Vector3f dir((signs & 1) ? -1.f : 1.f, (signs & 2) ? -1.f : 1.f,
+                                  (signs & 4) ? -1.f : 1.f);
+        const Eigen::Vector3f b = a + dir * static_cast<float>(d / std::sqrt(3.0) * (1 + delta));
+        const bool linked = PointsLinked(a, b, LinkDistanceSquared(d));
+        ASSERT_EQ(linked, delta < 0) << d << " " << delta;
+        auto r = ClusterLinks(PointCloud::Unorganized({a, b}), s);
+        ASSERT_TRUE(r.ok());
+        EXPECT_EQ(r->labels[0] == r->labels[1], linked) << d << " " << delta << " " << signs;
+      }
 }
 
 TEST(LinkClusteringUnorganized, OrganizedCloudThroughGeneralPathLinksAllPairs) {
@@ -274,7 +334,7 @@ TEST(LinkClusteringUnorganized, OrganizedCloudThroughGeneralPathLinksAllPairs) {
   // each other link there, not on the grid path.
   PointCloud c = PointCloud::Organized(4, 2);
   for (uint32_t i = 0; i < 8; ++i) c.points[i] = {(i % 4 == 3) ? 0.f : 10.f * i, 0.f, 0.f};
-  LinkClusteringSettings s;
+  LinkClusteringSettings s = HalfMm();
   s.min_cluster_points = 1;
   LinkClusteringResult grid, general;
   ASSERT_TRUE(ClusterLinksOrganized(c, s, grid).ok());
@@ -324,7 +384,7 @@ TEST(LinkClustering, ApplyFilterKeepsBitsAndGrid) {
   // A NaN payload in a no-data pixel must survive too.
   uint32_t payload = 0x7fc00123u;
   std::memcpy(c.points[5].data(), &payload, 4);
-  LinkClusteringSettings s;
+  LinkClusteringSettings s = HalfMm();
   s.min_cluster_points = 4;
   auto r = ClusterLinks(c, s);
   ASSERT_TRUE(r.ok());
@@ -382,6 +442,15 @@ TEST(LinkClustering, BadInputGivesClearErrors) {
   PointCloud inf_grid = PointCloud::Organized(4, 4);
   inf_grid.points[6] = {1.f, INFINITY, 0.f};
   expect_error(inf_grid, {}, "infinite");
+  // An infinity next to a NaN in the same point is still an infinity.
+  for (const Eigen::Vector3f& p : {Eigen::Vector3f(INFINITY, 0.f, NAN),
+                                   Eigen::Vector3f(NAN, NAN, -INFINITY),
+                                   Eigen::Vector3f(NAN, INFINITY, 2.f)}) {
+    PointCloud g = PointCloud::Organized(70, 3);  // the bad pixel in word 2
+    g.points[2 * 70 + 66] = p;
+    expect_error(g, {}, "infinite");
+    expect_error(PointCloud::Unorganized({{0, 0, 0}, p}), {}, "infinite");
+  }
   expect_error(PointCloud::Unorganized({{0, 0, 0}, {0, 0, -INFINITY}}), {}, "infinite");
   // 1 um links across 10 km: more cells than the key can hold.
   LinkClusteringSettings fine;

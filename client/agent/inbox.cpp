@@ -1,0 +1,54 @@
+#include "client/agent/inbox.h"
+
+#include <algorithm>
+#include <filesystem>
+
+#include "absl/strings/str_cat.h"
+#include "core/atomic_file.h"
+
+namespace surfinspect::client {
+namespace fs = std::filesystem;
+
+bool IsValidPartId(const std::string& id) {
+  if (id.empty() || id.size() > 128 || id == "." || id == "..") return false;
+  return std::all_of(id.begin(), id.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-';
+  });
+}
+
+std::vector<std::string> CompleteParts(const std::string& inbox) {
+  std::vector<std::string> parts;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(inbox, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.empty() || name[0] == '.' || !e.is_directory()) continue;
+    if (fs::exists(e.path() / "DONE")) parts.push_back(name);
+  }
+  std::sort(parts.begin(), parts.end());
+  return parts;
+}
+
+bool HasResults(const InboxLayout& layout, const std::string& id) {
+  return fs::exists(fs::path(layout.results) / id / "report.json");
+}
+
+absl::Status MovePart(const std::string& inbox, const std::string& dest, const std::string& id) {
+  std::error_code ec;
+  fs::create_directories(dest, ec);
+  if (ec) return absl::PermissionDeniedError(absl::StrCat(dest, ": ", ec.message()));
+  fs::path target = fs::path(dest) / id;
+  for (int n = 1; fs::exists(target); ++n) target = fs::path(dest) / absl::StrCat(id, ".", n);
+  fs::rename(fs::path(inbox) / id, target, ec);
+  if (ec) return absl::InternalError(absl::StrCat("cannot move ", id, " to ", dest, ": ", ec.message()));
+  return absl::OkStatus();
+}
+
+absl::Status Quarantine(const InboxLayout& layout, const std::string& id, const std::string& why) {
+  // error.txt goes in first, so the reason travels with the part.
+  if (auto st = WriteStringAtomically((fs::path(layout.inbox) / id / "error.txt").string(), why + "\n");
+      !st.ok())
+    return st;
+  return MovePart(layout.inbox, layout.quarantine, id);
+}
+
+}  // namespace surfinspect::client

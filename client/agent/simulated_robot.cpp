@@ -1,0 +1,95 @@
+#include "client/agent/simulated_robot.h"
+
+#include <filesystem>
+#include <random>
+
+#include "absl/strings/str_format.h"
+#include "core/atomic_file.h"
+#include "core/io_mesh.h"
+#include "core/io_point_cloud.h"
+#include "core/io_transform.h"
+#include "core/scan_simulator.h"
+
+namespace surfinspect::client {
+namespace fs = std::filesystem;
+
+absl::StatusOr<std::vector<std::string>> SimulateParts(const CellConfig& cell, const std::string& inbox,
+                                                       int count, uint64_t seed) {
+  auto part = ReadMesh(cell.part_mesh);
+  if (!part.ok()) return part.status();
+  SensorIntrinsics intrinsics;
+  if (cell.raw.contains("sensor")) {
+    const auto& s = cell.raw["sensor"];
+    intrinsics.width = s.value("width", intrinsics.width);
+    intrinsics.height = s.value("height", intrinsics.height);
+    intrinsics.horizontal_fov_deg = s.value("horizontal_fov_deg", intrinsics.horizontal_fov_deg);
+    intrinsics.min_range_mm = s.value("min_range_mm", intrinsics.min_range_mm);
+    intrinsics.max_range_mm = s.value("max_range_mm", intrinsics.max_range_mm);
+  }
+  const Bounds3 b = ComputeBounds(*part);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> ux(b.min.x() + 0.1 * (b.max.x() - b.min.x()),
+                                            b.max.x() - 0.1 * (b.max.x() - b.min.x()));
+  std::uniform_real_distribution<double> uy(-18, 18), udepth(0.05, 0.5), uradius(3, 8);
+  std::vector<std::string> ids;
+  for (int k = 0, n = 1; k < count; ++n) {
+    const std::string id = absl::StrFormat("sim-%04d-%04d", seed % 10000, n);
+    if (fs::exists(fs::path(inbox) / id)) continue;
+    ++k;
+    ScanOptions opt;
+    opt.noise_sigma_mm = 0.015;
+    opt.pulse_fraction = 0.003;
+    opt.stripes = true;
+    nlohmann::json defects = nlohmann::json::array();
+    for (int d = 0; d < 2; ++d) {
+      // On the ridge's top: find its height by a vertical probe of the mesh.
+      SurfaceDefect defect;
+      const double x = ux(rng), y = uy(rng);
+      defect.radius_mm = uradius(rng);
+      defect.depth_mm = (d == 1 ? -1 : 1) * udepth(rng);
+      double top = b.max.z();
+      for (const auto& t : part->triangles) {  // highest facet above (x, y)
+        const Eigen::Vector3d a = part->vertices[t[0]].cast<double>(), bb = part->vertices[t[1]].cast<double>(),
+                              c = part->vertices[t[2]].cast<double>();
+        const Eigen::Vector3d n = (bb - a).cross(c - a);
+        if (std::abs(n.z()) < 1e-9) continue;
+        const double z = a.z() - (n.x() * (x - a.x()) + n.y() * (y - a.y())) / n.z();
+        const Eigen::Vector3d p(x, y, z);
+        const bool inside = (bb - a).cross(p - a).z() * n.z() >= 0 && (c - bb).cross(p - bb).z() * n.z() >= 0 &&
+                            (a - c).cross(p - c).z() * n.z() >= 0;
+        if (inside) top = z;
+      }
+      defect.center_in_part = {x, y, top};
+      opt.defects.push_back(defect);
+      defects.push_back({{"center_in_part", {x, y, top}}, {"radius_mm", defect.radius_mm},
+                         {"depth_mm", defect.depth_mm}});
+    }
+    const fs::path dir = fs::path(inbox) / id;
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) return absl::PermissionDeniedError(dir.string() + ": " + ec.message());
+    for (std::size_t v = 0; v < cell.viewpoints.size(); ++v) {
+      const CellViewpoint& vp = cell.viewpoints[v];
+      // The robot really stands at the demo's true pose when the cell says so.
+      Eigen::Isometry3d pose = vp.world_from_sensor.value_or(vp.nominal_world_from_sensor);
+      for (const auto& jv : cell.raw["viewpoints"])
+        if (jv.value("name", "") == vp.name && jv.contains("simulation_truth_world_from_sensor"))
+          if (auto t = ParseTransformJson(jv["simulation_truth_world_from_sensor"].dump(), "truth"); t.ok())
+            pose = *t;
+      opt.seed = seed * 1000003 + n * 101 + v;
+      auto scan = SimulateScan(*part, cell.world_from_part, pose, intrinsics, opt);
+      if (!scan.ok()) return scan.status();
+      if (auto st = WritePointCloud((dir / (vp.name + ".pcd")).string(), scan->cloud_in_sensor); !st.ok())
+        return st;
+    }
+    if (auto st = WriteStringAtomically((dir / "truth.json").string(),
+                                        nlohmann::json{{"defects", defects}}.dump(2) + "\n");
+        !st.ok())
+      return st;
+    if (auto st = WriteStringAtomically((dir / "DONE").string(), ""); !st.ok()) return st;
+    ids.push_back(id);
+  }
+  return ids;
+}
+
+}  // namespace surfinspect::client

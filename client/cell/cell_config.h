@@ -1,0 +1,65 @@
+// cell.json: everything a robot cell needs to inspect parts. Paths inside
+// are relative to the file's directory. Written by `surfinspect demo-cell`
+// (or by hand), completed by `cell-agent calibrate`, read by `cell-agent run`
+// and `surfinspect inspect`:
+//   part.mesh, part.world_from_part         CAD of the part and its pose
+//   gauge.mesh                              CAD of the calibration gauge
+//   viewpoints[]: name, nominal_world_from_sensor, world_from_gauge,
+//                 gauge_scan, world_from_sensor (after calibration),
+//                 calibration (quality figures)
+//   tolerance_mm, error_map{...}, filter{...}   optional settings
+//   server{target, tls_ca, tls_cert, tls_key, token_file}   optional
+// Transforms are {"matrix": [[...]...]} (row-major, mm).
+#pragma once
+
+#include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/error_map.h"
+#include "core/inspection.h"
+#include "core/link_clustering.h"
+
+namespace surfinspect::client {
+
+struct CellViewpoint {
+  std::string name;
+  Eigen::Isometry3d nominal_world_from_sensor = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d world_from_gauge = Eigen::Isometry3d::Identity();
+  std::string gauge_scan;                                  // resolved path, may be empty
+  std::optional<Eigen::Isometry3d> world_from_sensor;      // calibrated
+};
+
+struct CellServer {
+  std::string target, tls_ca, tls_cert, tls_key, token_file;  // paths resolved
+};
+
+struct CellConfig {
+  std::string path;                 // of cell.json
+  std::string part_mesh, gauge_mesh;  // resolved paths
+  Eigen::Isometry3d world_from_part = Eigen::Isometry3d::Identity();
+  std::vector<CellViewpoint> viewpoints;
+  ErrorMapSettings error_map;
+  bool filter = true;
+  LinkClusteringSettings filter_settings;
+  CellServer server;
+  nlohmann::json raw;               // the whole file, kept for rewriting
+};
+
+absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path);
+
+// The cell's filter and error-map settings as one InspectionSettings.
+InspectionSettings InspectionSettingsOf(const CellConfig& cell);
+
+// Stores each calibrated viewpoint's world_from_sensor and quality (JSON)
+// into the file: the previous file is kept as cell.json.bak, the new one is
+// written to a temporary file and renamed over cell.json.
+absl::Status WriteCellCalibrations(const CellConfig& cell,
+                                   const std::vector<std::pair<std::string, nlohmann::json>>& quality);
+
+nlohmann::json TransformJson(const Eigen::Isometry3d& t);
+
+}  // namespace surfinspect::client

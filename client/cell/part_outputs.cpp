@@ -1,0 +1,95 @@
+#include "client/cell/part_outputs.h"
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "absl/strings/str_cat.h"
+#include "core/atomic_file.h"
+#include "core/error_map_output.h"
+#include "proto/convert.h"
+
+namespace surfinspect::client {
+namespace {
+
+absl::Status FillFromReport(PartOutputs& o) {
+  const nlohmann::json j = nlohmann::json::parse(o.report_json, nullptr, false);
+  if (j.is_discarded()) return absl::DataLossError("report is not valid JSON");
+  try {
+    o.tolerance_mm = j.at("tolerance").at("band_mm").get<double>();
+    o.color_range_mm = j.at("color_range_mm").get<double>();
+    const auto& st = j.at("statistics");
+    o.min_mm = st.value("min_mm", 0.0);
+    o.max_mm = st.value("max_mm", 0.0);
+  } catch (const nlohmann::json::exception&) {
+    // Extremes are only for the summary line; colours need the two above.
+    if (!(o.tolerance_mm > 0)) return absl::DataLossError("report lacks tolerance.band_mm");
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::StatusOr<PartOutputs> OutputsFromLocal(const std::string& part_id, const InspectionResult& r,
+                                             const InspectionSettings& settings,
+                                             const Eigen::Isometry3d& world_from_part,
+                                             const TriangleMesh& part) {
+  PartOutputs o;
+  o.part_id = part_id;
+  o.verdict = r.error_map.verdict.pass ? "pass" : "fail";
+  o.report_json = ErrorMapReportText(r.error_map, settings.error_map);
+  auto png = ErrorMapPngBytes(r.merged.cloud_in_world, world_from_part, r.error_map, part);
+  if (!png.ok()) return png.status();
+  o.png = *std::move(png);
+  o.merged_in_world = r.merged.cloud_in_world;
+  o.deviation_mm = r.error_map.deviation_mm;
+  if (auto st = FillFromReport(o); !st.ok()) return st;
+  return o;
+}
+
+absl::StatusOr<PartOutputs> OutputsFromRemote(const v1::InspectResult& r) {
+  PartOutputs o;
+  o.part_id = r.part_id();
+  o.verdict = r.verdict();
+  o.report_json = r.report_json();
+  o.png = r.png();
+  auto merged = wire::CloudFromBytes(r.merged().xyz(), r.merged().width(), r.merged().height(), "merged");
+  if (!merged.ok()) return merged.status();
+  o.merged_in_world = *std::move(merged);
+  o.deviation_mm = wire::UnpackFloats(r.deviations());
+  if (o.deviation_mm.size() != o.merged_in_world.size())
+    return absl::DataLossError("server sent a deviation count that does not match the cloud");
+  if (auto st = FillFromReport(o); !st.ok()) return st;
+  return o;
+}
+
+v1::PartHeader MakePartHeader(const std::string& part_id, const Eigen::Isometry3d& world_from_part,
+                              const InspectionSettings& settings) {
+  v1::PartHeader header;
+  header.set_part_id(part_id);
+  header.set_idempotency_key(part_id);  // a part is inspected once, whoever asks
+  wire::TransformToProto(world_from_part, header.mutable_world_from_part());
+  wire::ErrorMapSettingsToProto(settings.error_map, header.mutable_error_map());
+  wire::FilterSettingsToProto(settings.filter_settings, header.mutable_filter());
+  header.set_skip_filter(!settings.filter);
+  header.set_return_deviations(true);
+  header.set_return_png(true);
+  return header;
+}
+
+absl::Status WritePartOutputs(const std::string& dir, const PartOutputs& o) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return absl::PermissionDeniedError(absl::StrCat(dir, ": ", ec.message()));
+  // The PLY/CSV writers only read deviations, tolerance and colour range.
+  ErrorMapResult view;
+  view.deviation_mm = o.deviation_mm;
+  view.tolerance_mm = o.tolerance_mm;
+  view.color_range_mm = o.color_range_mm;
+  if (auto st = WriteErrorMapPly(dir + "/errormap.ply", o.merged_in_world, view, "world"); !st.ok()) return st;
+  if (auto st = WriteErrorMapCsv(dir + "/deviations.csv", o.merged_in_world, view); !st.ok()) return st;
+  if (auto st = WriteStringAtomically(dir + "/errormap.png", o.png); !st.ok()) return st;
+  // The report last: its presence means the part's results are complete.
+  return WriteStringAtomically(dir + "/report.json", o.report_json);
+}
+
+}  // namespace surfinspect::client

@@ -1,0 +1,43 @@
+// What an inspected part leaves on disk, the same whether it was computed
+// in-process or by surfinspectd: report.json, errormap.ply (world frame,
+// deviation + colour per point), errormap.png and deviations.csv, each
+// written atomically (temporary file, then rename).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/inspection.h"
+#include "core/point_cloud.h"
+#include "surfinspect/v1/inspection.pb.h"
+
+namespace surfinspect::client {
+
+struct PartOutputs {
+  std::string part_id;
+  std::string verdict;              // "pass" / "fail"
+  std::string report_json;
+  std::string png;                  // PNG bytes
+  PointCloud merged_in_world;       // merged, valid points
+  std::vector<float> deviation_mm;  // per merged point
+  double tolerance_mm = 0, color_range_mm = 0;
+  // For people: from the report.
+  double min_mm = 0, max_mm = 0;
+};
+
+absl::StatusOr<PartOutputs> OutputsFromLocal(const std::string& part_id, const InspectionResult& r,
+                                             const InspectionSettings& settings,
+                                             const Eigen::Isometry3d& world_from_part,
+                                             const TriangleMesh& part);
+absl::StatusOr<PartOutputs> OutputsFromRemote(const ::surfinspect::v1::InspectResult& r);
+
+// The Inspect stream's header for a part, asking for everything the part
+// outputs need (deviations, merged cloud and PNG).
+::surfinspect::v1::PartHeader MakePartHeader(const std::string& part_id,
+                                             const Eigen::Isometry3d& world_from_part,
+                                             const InspectionSettings& settings);
+
+absl::Status WritePartOutputs(const std::string& dir, const PartOutputs& outputs);
+
+}  // namespace surfinspect::client

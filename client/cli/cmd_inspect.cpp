@@ -1,0 +1,73 @@
+// surfinspect inspect: a whole part from a cell.json and a folder of
+// per-viewpoint scans (<viewpoint>.pcd): filter, register, error map, and
+// the part's result files; in-process or streamed to surfinspectd.
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+
+#include "client/cell/cell_config.h"
+#include "client/cell/part_outputs.h"
+#include "client/cli/commands.h"
+#include "client/cli/remote_args.h"
+#include "core/inspection.h"
+#include "core/io_mesh.h"
+#include "core/io_point_cloud.h"
+#include "proto/convert.h"
+
+namespace surfinspect::cli {
+namespace {
+
+struct InspectArgs {
+  std::string cell, scans, out, part_id;
+  double tolerance = 0;
+  RemoteArgs remote;
+};
+
+void Inspect(const InspectArgs& a) {
+  const client::CellConfig cell = Take(client::ReadCellConfig(a.cell));
+  const TriangleMesh part = Take(ReadMesh(cell.part_mesh));
+  InspectionSettings settings = client::InspectionSettingsOf(cell);
+  if (a.tolerance > 0) settings.error_map.tolerance_mm = a.tolerance;
+  std::vector<ViewScan> views;
+  for (const auto& vp : cell.viewpoints) {
+    const std::string path = a.scans + "/" + vp.name + ".pcd";
+    if (!std::filesystem::exists(path)) continue;
+    if (!vp.world_from_sensor)
+      throw CommandFailed(a.cell + ": viewpoint " + vp.name + " is not calibrated (run cell-agent calibrate)");
+    views.push_back({vp.name, Take(ReadPointCloud(path)), *vp.world_from_sensor});
+  }
+  if (views.empty()) throw CommandFailed(a.scans + ": no <viewpoint>.pcd scans for this cell");
+  const std::string part_id =
+      a.part_id.empty() ? std::filesystem::path(a.scans).filename().string() : a.part_id;
+  client::PartOutputs outputs;
+  if (a.remote.remote()) {
+    const v1::PartHeader header = client::MakePartHeader(part_id, cell.world_from_part, settings);
+    auto result = Take(Connect(a.remote)->Inspect(header, part, views, [](const v1::Progress& p) {
+      spdlog::info("{} {} ({} points)", v1::Progress::Stage_Name(p.stage()), p.view(), p.points());
+    }));
+    outputs = Take(client::OutputsFromRemote(result));
+  } else {
+    auto index = Take(MeshIndex::Build(part));
+    const InspectionResult r = Take(InspectPart(*index, cell.world_from_part, std::move(views), settings));
+    outputs = Take(client::OutputsFromLocal(part_id, r, settings, cell.world_from_part, part));
+  }
+  Check(client::WritePartOutputs(a.out, outputs));
+  std::printf("%s: %s  (min %.3f mm, max %.3f mm)  -> %s\n", part_id.c_str(), outputs.verdict.c_str(),
+              outputs.min_mm, outputs.max_mm, a.out.c_str());
+}
+
+}  // namespace
+
+void AddInspectCommand(CLI::App& app) {
+  auto a = std::make_shared<InspectArgs>();
+  auto* cmd = app.add_subcommand("inspect", "Inspect a whole part: filter, register, error map");
+  cmd->add_option("--cell", a->cell, "cell.json (calibrated viewpoints, part mesh and pose)")->required();
+  cmd->add_option("--scans", a->scans, "folder with <viewpoint>.pcd scans of one part")->required();
+  cmd->add_option("--out", a->out, "results folder (report.json, errormap.ply/.png, deviations.csv)")->required();
+  cmd->add_option("--part-id", a->part_id, "default: the scans folder's name");
+  cmd->add_option("--tolerance", a->tolerance, "override the cell's tolerance, mm")->check(CLI::PositiveNumber);
+  AddRemoteOptions(cmd, a->remote);
+  cmd->callback([a] { Inspect(*a); });
+}
+
+}  // namespace surfinspect::cli

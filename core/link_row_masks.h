@@ -1,0 +1,46 @@
+// Row kernels of the grid link clustering (link_clustering_grid.cpp): a
+// sensor row copied to structure-of-arrays, then one pass that turns it into
+// 64-bit masks of valid pixels and of links to the west, north-west, north
+// and north-east neighbours. With SSE2 four pixels are tested per
+// instruction, with the float operations of PointsLinked in its order, so
+// the masks agree bit for bit with the scalar predicate.
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace surfinspect::link_row {
+
+// One row as structure-of-arrays, padded with NaN on both sides to a whole
+// number of 64-bit mask words: a link to a pixel outside the grid compares
+// NaN and is false with no bounds test.
+struct RowSoA {
+  std::vector<float> buf[3];
+  explicit RowSoA(uint32_t padded) {
+    for (auto& b : buf) b.assign(padded + 2, NAN);
+  }
+  float* c(int a) { return buf[a].data() + 1; }
+  const float* c(int a) const { return buf[a].data() + 1; }
+};
+
+// Per-row bit masks, bit j of word k for pixel 64k + j.
+struct RowMasks {
+  uint64_t *valid, *west, *north_west, *north, *north_east;
+};
+
+// Copies w points into the SoA row (SSE2: 4 points = 3 loads, 7 shuffles).
+void Transpose(const Eigen::Vector3f* pts, uint32_t w, RowSoA& row);
+
+// Fills `masks` for `words` 64-pixel words of `cur`: valid (all coordinates
+// finite), west link and, when `up` (the row above) is given, north and, with
+// `diagonals`, north-west and north-east links; NaN never links. Returns
+// whether an infinite coordinate was seen (forbidden by the cloud contract).
+bool ComputeMasks(const RowSoA& cur, const RowSoA* up, bool diagonals, uint32_t words,
+                  float link_distance_sq, const RowMasks& masks);
+
+// Bounds of the pixels first..last of the row, which must all be valid.
+void Bounds(const RowSoA& row, uint32_t first, uint32_t last, float lo[3], float hi[3]);
+
+}  // namespace surfinspect::link_row

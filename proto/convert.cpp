@@ -1,0 +1,222 @@
+#include "proto/convert.h"
+
+#include <cmath>
+#include <cstring>
+
+#include "absl/strings/str_cat.h"
+#include "core/transform.h"
+
+namespace surfinspect::wire {
+namespace {
+
+absl::Status Invalid(const std::string& field, absl::string_view why) {
+  return absl::InvalidArgumentError(absl::StrCat(field, ": ", why));
+}
+
+}  // namespace
+
+absl::Status CheckCloudShape(uint64_t width, uint64_t height, const std::string& field,
+                             const Limits& limits) {
+  if (width == 0 || height == 0) return Invalid(field, "width and height must be > 0 (empty cloud)");
+  if (width * height > limits.max_points)
+    return absl::ResourceExhaustedError(absl::StrCat(field, ": ", width * height,
+                                                     " points exceed the server limit of ",
+                                                     limits.max_points));
+  return absl::OkStatus();
+}
+
+absl::StatusOr<PointCloud> CloudFromBytes(const std::string& xyz, uint32_t width, uint32_t height,
+                                          const std::string& field) {
+  const uint64_t n = uint64_t{width} * height;
+  if (xyz.size() != n * 12)
+    return Invalid(field, absl::StrCat("xyz holds ", xyz.size(), " bytes but width*height*12 = ",
+                                       n * 12));
+  PointCloud c;
+  c.width = width;
+  c.height = height;
+  c.points.resize(n);
+  std::memcpy(static_cast<void*>(c.points.data()), xyz.data(), xyz.size());
+  if (auto st = c.Validate(); !st.ok()) return Invalid(field, st.message());
+  return c;
+}
+
+absl::StatusOr<PointCloud> CloudFromProto(const v1::PointCloud& msg, const std::string& field,
+                                          const Limits& limits) {
+  if (auto st = CheckCloudShape(msg.width(), msg.height(), field, limits); !st.ok()) return st;
+  return CloudFromBytes(msg.xyz(), msg.width(), msg.height(), field);
+}
+
+void CloudToProto(const PointCloud& cloud, v1::PointCloud* msg) {
+  msg->set_width(cloud.width);
+  msg->set_height(cloud.height);
+  msg->mutable_xyz()->assign(reinterpret_cast<const char*>(cloud.points.data()), cloud.size() * 12);
+}
+
+absl::StatusOr<Eigen::Isometry3d> TransformFromProto(const v1::Transform& msg, const std::string& field) {
+  if (msg.row_major_size() != 16)
+    return Invalid(field, absl::StrCat("needs 16 row-major values, got ", msg.row_major_size()));
+  RowMajor16 v{};
+  for (int i = 0; i < 16; ++i) v[i] = msg.row_major(i);
+  return FromRowMajor(v, field);
+}
+
+void TransformToProto(const Eigen::Isometry3d& t, v1::Transform* msg) {
+  msg->clear_row_major();
+  for (double x : ToRowMajor(t)) msg->add_row_major(x);
+}
+
+absl::StatusOr<TriangleMesh> MeshFromProto(const v1::InlineMesh& msg, const std::string& field,
+                                           const Limits& limits) {
+  if (msg.vertices().size() % 12 != 0 || msg.triangles().size() % 12 != 0)
+    return Invalid(field, "vertices and triangles must be whole 12-byte records");
+  const uint64_t nt = msg.triangles().size() / 12;
+  if (nt > limits.max_triangles)
+    return absl::ResourceExhaustedError(absl::StrCat(field, ": ", nt,
+                                                     " triangles exceed the server limit of ",
+                                                     limits.max_triangles));
+  TriangleMesh m;
+  m.vertices.resize(msg.vertices().size() / 12);
+  m.triangles.resize(nt);
+  std::memcpy(static_cast<void*>(m.vertices.data()), msg.vertices().data(), msg.vertices().size());
+  std::memcpy(m.triangles.data(), msg.triangles().data(), msg.triangles().size());
+  if (auto st = m.Validate(); !st.ok()) return Invalid(field, st.message());
+  return m;
+}
+
+void MeshToProto(const TriangleMesh& mesh, v1::InlineMesh* msg) {
+  msg->mutable_vertices()->assign(reinterpret_cast<const char*>(mesh.vertices.data()),
+                                  mesh.vertices.size() * 12);
+  msg->mutable_triangles()->assign(reinterpret_cast<const char*>(mesh.triangles.data()),
+                                   mesh.triangles.size() * 12);
+}
+
+absl::StatusOr<LinkClusteringSettings> FilterSettingsFromProto(const v1::FilterSettings& msg,
+                                                               const std::string& field) {
+  LinkClusteringSettings s;
+  if (msg.has_link_distance_mm()) s.link_distance_mm = msg.link_distance_mm();
+  if (msg.has_min_cluster_points()) s.min_cluster_points = msg.min_cluster_points();
+  if (msg.has_connectivity()) s.connectivity = static_cast<int>(msg.connectivity());
+  if (msg.has_min_fraction_of_largest()) s.min_fraction_of_largest = msg.min_fraction_of_largest();
+  if (auto st = ValidateLinkClusteringSettings(s); !st.ok()) return Invalid(field, st.message());
+  return s;
+}
+
+void FilterSettingsToProto(const LinkClusteringSettings& s, v1::FilterSettings* msg) {
+  msg->set_link_distance_mm(s.link_distance_mm);
+  msg->set_min_cluster_points(s.min_cluster_points);
+  msg->set_connectivity(static_cast<uint32_t>(s.connectivity));
+  msg->set_min_fraction_of_largest(s.min_fraction_of_largest);
+}
+
+void FilterStatsToProto(const LinkClusteringResult& r, v1::FilterStats* msg) {
+  msg->set_input_points(r.input_points);
+  msg->set_valid_points(r.valid_points);
+  msg->set_kept(r.kept);
+  msg->set_removed(r.removed);
+  msg->set_clusters(r.clusters.size());
+  msg->set_largest_cluster(r.largest_cluster);
+}
+
+absl::StatusOr<IcpSettings> IcpSettingsFromProto(const v1::IcpSettings& msg, const std::string& field) {
+  IcpSettings s;
+  switch (msg.step()) {
+    case v1::IcpSettings::STEP_UNSPECIFIED:
+    case v1::IcpSettings::STEP_POINT_TO_POINT: s.step = IcpStep::kPointToPoint; break;
+    case v1::IcpSettings::STEP_POINT_TO_PLANE: s.step = IcpStep::kPointToPlane; break;
+    default: return Invalid(field + ".step", "unknown step");
+  }
+  if (msg.has_max_iterations()) {
+    if (msg.max_iterations() > 10000) return Invalid(field + ".max_iterations", "must be <= 10000");
+    s.max_iterations = static_cast<int>(msg.max_iterations());
+  }
+  if (msg.has_max_correspondence_mm()) s.max_correspondence_mm = msg.max_correspondence_mm();
+  if (msg.has_min_correspondence_mm()) s.min_correspondence_mm = msg.min_correspondence_mm();
+  if (msg.has_trim_fraction()) s.trim_fraction = msg.trim_fraction();
+  if (msg.has_relative_cost_tolerance()) s.relative_cost_tolerance = msg.relative_cost_tolerance();
+  if (msg.has_max_points()) s.max_points = msg.max_points();
+  if (!(s.max_correspondence_mm > 0) || !std::isfinite(s.max_correspondence_mm))
+    return Invalid(field + ".max_correspondence_mm", "must be finite and > 0");
+  if (!(s.min_correspondence_mm > 0) || s.min_correspondence_mm > s.max_correspondence_mm)
+    return Invalid(field + ".min_correspondence_mm", "must be > 0 and <= max_correspondence_mm");
+  if (!(s.trim_fraction >= 0 && s.trim_fraction < 0.9))
+    return Invalid(field + ".trim_fraction", "must be in [0, 0.9)");
+  if (!(s.relative_cost_tolerance >= 0) || !std::isfinite(s.relative_cost_tolerance))
+    return Invalid(field + ".relative_cost_tolerance", "must be finite and >= 0");
+  return s;
+}
+
+void IcpSettingsToProto(const IcpSettings& s, v1::IcpSettings* msg) {
+  msg->set_step(s.step == IcpStep::kPointToPlane ? v1::IcpSettings::STEP_POINT_TO_PLANE
+                                                 : v1::IcpSettings::STEP_POINT_TO_POINT);
+  msg->set_max_iterations(static_cast<uint32_t>(s.max_iterations));
+  msg->set_max_correspondence_mm(s.max_correspondence_mm);
+  msg->set_min_correspondence_mm(s.min_correspondence_mm);
+  msg->set_trim_fraction(s.trim_fraction);
+  msg->set_relative_cost_tolerance(s.relative_cost_tolerance);
+  msg->set_max_points(static_cast<uint32_t>(s.max_points));
+}
+
+void CalibrationToProto(const CalibrationResult& r, v1::CalibrateResponse* msg) {
+  TransformToProto(r.world_from_sensor, msg->mutable_world_from_sensor());
+  TransformToProto(r.gauge_from_sensor, msg->mutable_gauge_from_sensor());
+  v1::CalibrationQuality* q = msg->mutable_quality();
+  q->set_rms_mm(r.rms_mm);
+  q->set_iterations(static_cast<uint32_t>(r.icp.iterations));
+  q->set_converged(r.icp.converged);
+  q->set_stop_reason(ToString(r.icp.stop_reason));
+  q->set_inlier_fraction(r.inlier_fraction);
+  q->set_sigma_translation_um(r.sigma_translation_um);
+  q->set_sigma_rotation_deg(r.sigma_rotation_deg);
+  q->set_degenerate(r.degenerate);
+  q->set_degeneracy_ratio(r.degeneracy_ratio);
+  q->set_residual_p50_mm(r.residual_p50_mm);
+  q->set_residual_p95_mm(r.residual_p95_mm);
+  q->set_residual_p99_mm(r.residual_p99_mm);
+  q->set_filtered_points(r.filtered_points);
+  for (double c : r.icp.cost_history) q->add_cost_history(c);
+  for (const auto& w : r.warnings) q->add_warnings(w);
+}
+
+absl::StatusOr<ErrorMapSettings> ErrorMapSettingsFromProto(const v1::ErrorMapSettings& msg,
+                                                           const std::string& field) {
+  ErrorMapSettings s;
+  if (msg.has_tolerance_mm()) s.tolerance_mm = msg.tolerance_mm();
+  if (msg.has_max_distance_mm()) s.max_distance_mm = msg.max_distance_mm();
+  if (msg.has_allowed_fraction_outside()) s.allowed_fraction_outside = msg.allowed_fraction_outside();
+  if (msg.has_histogram_bins()) {
+    if (msg.histogram_bins() > 10001) return Invalid(field + ".histogram_bins", "must be <= 10001");
+    s.histogram_bins = static_cast<int>(msg.histogram_bins());
+  }
+  if (msg.has_histogram_range_mm()) s.histogram_range_mm = msg.histogram_range_mm();
+  s.split_components = msg.split_components();
+  if (!(s.tolerance_mm > 0) || !std::isfinite(s.tolerance_mm))
+    return Invalid(field + ".tolerance_mm", "must be finite and > 0");
+  if (!(s.max_distance_mm > 0)) return Invalid(field + ".max_distance_mm", "must be > 0");
+  if (!(s.allowed_fraction_outside >= 0 && s.allowed_fraction_outside <= 1))
+    return Invalid(field + ".allowed_fraction_outside", "must be in [0, 1]");
+  if (s.histogram_bins < 1) return Invalid(field + ".histogram_bins", "must be >= 1");
+  if (!(s.histogram_range_mm >= 0) || !std::isfinite(s.histogram_range_mm))
+    return Invalid(field + ".histogram_range_mm", "must be finite and >= 0");
+  return s;
+}
+
+void ErrorMapSettingsToProto(const ErrorMapSettings& s, v1::ErrorMapSettings* msg) {
+  msg->set_tolerance_mm(s.tolerance_mm);
+  msg->set_max_distance_mm(s.max_distance_mm);
+  msg->set_allowed_fraction_outside(s.allowed_fraction_outside);
+  msg->set_histogram_bins(static_cast<uint32_t>(s.histogram_bins));
+  msg->set_histogram_range_mm(s.histogram_range_mm);
+  msg->set_split_components(s.split_components);
+}
+
+std::string PackFloats(const std::vector<float>& v) {
+  return std::string(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(float));
+}
+
+std::vector<float> UnpackFloats(const std::string& bytes) {
+  std::vector<float> v(bytes.size() / sizeof(float));
+  std::memcpy(v.data(), bytes.data(), v.size() * sizeof(float));
+  return v;
+}
+
+}  // namespace surfinspect::wire

@@ -1,0 +1,310 @@
+#include "server/inspection_service.h"
+
+#include <openssl/crypto.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <nlohmann/json.hpp>
+
+#include "absl/strings/str_cat.h"
+#include "core/calibration.h"
+#include "core/inspection.h"
+#include "core/link_clustering.h"
+#include "core/mesh_hash.h"
+#include "core/registration.h"
+#include "core/transform.h"
+#include "server/status_mapping.h"
+
+namespace surfinspect::server {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+const char* CodeName(grpc::StatusCode code) {
+  switch (code) {
+    case grpc::StatusCode::OK: return "OK";
+    case grpc::StatusCode::CANCELLED: return "CANCELLED";
+    case grpc::StatusCode::INVALID_ARGUMENT: return "INVALID_ARGUMENT";
+    case grpc::StatusCode::DEADLINE_EXCEEDED: return "DEADLINE_EXCEEDED";
+    case grpc::StatusCode::NOT_FOUND: return "NOT_FOUND";
+    case grpc::StatusCode::FAILED_PRECONDITION: return "FAILED_PRECONDITION";
+    case grpc::StatusCode::RESOURCE_EXHAUSTED: return "RESOURCE_EXHAUSTED";
+    case grpc::StatusCode::UNAUTHENTICATED: return "UNAUTHENTICATED";
+    case grpc::StatusCode::UNAVAILABLE: return "UNAVAILABLE";
+    case grpc::StatusCode::INTERNAL: return "INTERNAL";
+    default: return "OTHER";
+  }
+}
+
+// One reactor per unary heavy call. The work runs on the pool; Finish is
+// the last thing it touches, because OnDone (which deletes the reactor) may
+// run as soon as Finish is called.
+class HeavyCall final : public grpc::ServerUnaryReactor {
+ public:
+  using Work = std::function<grpc::Status(const std::atomic<bool>& cancel)>;
+  HeavyCall(InspectionService* service, grpc::CallbackServerContext* ctx, const char* method,
+            uint64_t points, Work work)
+      : service_(service), ctx_(ctx), method_(method), points_(points), work_(std::move(work)),
+        request_id_(service->RequestId(ctx)), start_(Clock::now()) {}
+
+  void Start() {
+    if (grpc::Status auth = service_->Authorize(ctx_); !auth.ok()) return Done(auth);
+    service_->metrics()->CallStarted();
+    admitted_ = true;
+    if (!service_->pool().TrySubmit([this] { Run(); }))
+      Done(grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                        absl::StrCat("server busy: ", service_->config().max_admitted_calls,
+                                     " heavy calls already admitted; retry with backoff")));
+  }
+  void OnCancel() override { cancel_.store(true); }
+  void OnDone() override { delete this; }
+
+ private:
+  void Run() {
+    grpc::Status st;
+    try {
+      st = cancel_.load() ? grpc::Status(grpc::StatusCode::CANCELLED, "cancelled before start")
+                          : work_(cancel_);
+    } catch (const std::exception& e) {  // never let an exception cross the RPC
+      st = grpc::Status(grpc::StatusCode::INTERNAL, absl::StrCat("internal error: ", e.what()));
+    }
+    Done(st);
+  }
+  void Done(const grpc::Status& st) {
+    const double seconds = std::chrono::duration<double>(Clock::now() - start_).count();
+    service_->LogCall(request_id_, method_, ctx_->peer(), points_, st, seconds);
+    service_->metrics()->RecordRpc(method_, CodeName(st.error_code()), seconds);
+    if (st.ok()) service_->metrics()->AddPoints(points_);
+    if (admitted_) service_->metrics()->CallEnded();
+    Finish(st);
+  }
+
+  InspectionService* service_;
+  grpc::CallbackServerContext* ctx_;
+  const char* method_;
+  uint64_t points_;
+  Work work_;
+  std::string request_id_;
+  Clock::time_point start_;
+  bool admitted_ = false;
+  std::atomic<bool> cancel_{false};
+};
+
+grpc::Status FromCore(const absl::Status& st) { return ToGrpc(st); }
+
+}  // namespace
+
+InspectionService::InspectionService(ServiceConfig config, Metrics* metrics)
+    : config_(std::move(config)), metrics_(metrics), mesh_cache_(config_.mesh_cache_bytes),
+      pool_(config_.threads, config_.max_admitted_calls) {}
+
+InspectionService::~InspectionService() = default;
+
+grpc::Status InspectionService::Authorize(const grpc::CallbackServerContext* ctx) const {
+  if (config_.auth_token.empty()) return grpc::Status::OK;
+  const auto& md = ctx->client_metadata();
+  auto it = md.find("authorization");
+  const std::string expected = "Bearer " + config_.auth_token;
+  if (it == md.end())
+    return grpc::Status(grpc::StatusCode::UNAUTHENTICATED, "missing authorization: Bearer token");
+  const std::string got(it->second.data(), it->second.size());
+  // Constant-time comparison: no timing oracle on the token.
+  if (got.size() != expected.size() || CRYPTO_memcmp(got.data(), expected.data(), got.size()) != 0)
+    return grpc::Status(grpc::StatusCode::UNAUTHENTICATED, "bad bearer token");
+  return grpc::Status::OK;
+}
+
+grpc::Status InspectionService::ResolveMesh(grpc::CallbackServerContext* ctx, const v1::MeshRef& ref,
+                                            const std::string& field,
+                                            std::shared_ptr<const MeshIndex>* out) {
+  if (ref.has_inline_()) {
+    const std::string hash = MeshSha256(ref.inline_().vertices(), ref.inline_().triangles());
+    if ((*out = mesh_cache_.Find(hash))) {
+      metrics_->MeshCacheHit();
+      return grpc::Status::OK;
+    }
+    metrics_->MeshCacheMiss();
+    auto mesh = wire::MeshFromProto(ref.inline_(), field + ".inline", config_.limits);
+    if (!mesh.ok()) return FromCore(mesh.status());
+    auto index = MeshIndex::Build(*std::move(mesh));
+    if (!index.ok()) return FromCore(index.status());
+    std::shared_ptr<const MeshIndex> shared(std::move(*index));
+    mesh_cache_.Insert(hash, shared);
+    *out = std::move(shared);
+    return grpc::Status::OK;
+  }
+  if (ref.source_case() == v1::MeshRef::kSha256) {
+    if ((*out = mesh_cache_.Find(ref.sha256()))) {
+      metrics_->MeshCacheHit();
+      return grpc::Status::OK;
+    }
+    metrics_->MeshCacheMiss();
+    ctx->AddTrailingMetadata("surfinspect-reason", "MESH_NOT_CACHED");
+    return grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
+                        absl::StrCat("MESH_NOT_CACHED: ", field, ".sha256 ", ref.sha256(),
+                                     " is not cached on this replica; send the mesh inline"));
+  }
+  return InvalidField(field, "mesh is missing (set inline or sha256)");
+}
+
+std::string InspectionService::RequestId(const grpc::CallbackServerContext* ctx) {
+  auto it = ctx->client_metadata().find("x-request-id");
+  if (it != ctx->client_metadata().end() && it->second.size() <= 128)
+    return std::string(it->second.data(), it->second.size());
+  return absl::StrCat("r", next_request_.fetch_add(1));
+}
+
+void InspectionService::LogCall(const std::string& request_id, const std::string& method,
+                                const std::string& peer, uint64_t points, const grpc::Status& st,
+                                double seconds) {
+  if (config_.json_logs) {
+    // spdlog does not escape JSON; nlohmann does.
+    const nlohmann::json line = {{"event", "rpc"},          {"request_id", request_id},
+                                 {"method", method},        {"peer", peer},
+                                 {"points", points},        {"code", CodeName(st.error_code())},
+                                 {"message", st.error_message()}, {"seconds", seconds}};
+    spdlog::info("{}", line.dump());
+    return;
+  }
+  if (st.ok())
+    spdlog::info("[{}] {} from {}: OK, {} points, {:.3f} s", request_id, method, peer, points, seconds);
+  else
+    spdlog::warn("[{}] {} from {}: {} ({}), {} points, {:.3f} s", request_id, method, peer,
+                 CodeName(st.error_code()), st.error_message(), points, seconds);
+}
+
+grpc::ServerUnaryReactor* InspectionService::RunHeavy(grpc::CallbackServerContext* ctx,
+                                                      const char* method, uint64_t points, Work work) {
+  auto* call = new HeavyCall(this, ctx, method, points, std::move(work));
+  call->Start();
+  return call;
+}
+
+grpc::ServerUnaryReactor* InspectionService::Filter(grpc::CallbackServerContext* ctx,
+                                                    const v1::FilterRequest* req,
+                                                    v1::FilterResponse* resp) {
+  const uint64_t points = uint64_t{req->cloud().width()} * req->cloud().height();
+  return RunHeavy(ctx, "Filter", points, [this, req, resp](const std::atomic<bool>& cancel) {
+    auto cloud = wire::CloudFromProto(req->cloud(), "cloud", config_.limits);
+    if (!cloud.ok()) return FromCore(cloud.status());
+    auto settings = wire::FilterSettingsFromProto(req->settings(), "settings");
+    if (!settings.ok()) return FromCore(settings.status());
+    auto clusters = ClusterLinks(*cloud, *settings, &cancel);
+    if (!clusters.ok()) return FromCore(clusters.status());
+    auto filtered = ApplyFilter(*cloud, *clusters);
+    if (!filtered.ok()) return FromCore(filtered.status());
+    wire::CloudToProto(*filtered, resp->mutable_cloud());
+    wire::FilterStatsToProto(*clusters, resp->mutable_stats());
+    resp->mutable_kept_mask()->assign(clusters->kept_mask.begin(), clusters->kept_mask.end());
+    return grpc::Status::OK;
+  });
+}
+
+grpc::ServerUnaryReactor* InspectionService::Calibrate(grpc::CallbackServerContext* ctx,
+                                                       const v1::CalibrateRequest* req,
+                                                       v1::CalibrateResponse* resp) {
+  const uint64_t points = uint64_t{req->scan().width()} * req->scan().height();
+  return RunHeavy(ctx, "Calibrate", points, [this, ctx, req, resp](const std::atomic<bool>& cancel) {
+    auto world_from_gauge = wire::TransformFromProto(req->world_from_gauge(), "world_from_gauge");
+    if (!world_from_gauge.ok()) return FromCore(world_from_gauge.status());
+    auto initial = wire::TransformFromProto(req->initial_world_from_sensor(), "initial_world_from_sensor");
+    if (!initial.ok()) return FromCore(initial.status());
+    auto scan = wire::CloudFromProto(req->scan(), "scan", config_.limits);
+    if (!scan.ok()) return FromCore(scan.status());
+    CalibrationSettings settings;
+    settings.filter_outliers = !req->skip_filter();
+    auto filter = wire::FilterSettingsFromProto(req->filter(), "filter");
+    if (!filter.ok()) return FromCore(filter.status());
+    settings.filter = *filter;
+    auto icp = wire::IcpSettingsFromProto(req->icp(), "icp");
+    if (!icp.ok()) return FromCore(icp.status());
+    settings.icp = *icp;
+    std::shared_ptr<const MeshIndex> gauge;
+    if (grpc::Status st = ResolveMesh(ctx, req->gauge(), "gauge", &gauge); !st.ok()) return st;
+    auto cal = CalibrateViewpoint(*gauge, *world_from_gauge, *scan, *initial, settings, &cancel);
+    if (!cal.ok()) return FromCore(cal.status());
+    wire::CalibrationToProto(*cal, resp);
+    return grpc::Status::OK;
+  });
+}
+
+grpc::ServerUnaryReactor* InspectionService::Register(grpc::CallbackServerContext* ctx,
+                                                      const v1::RegisterRequest* req,
+                                                      v1::RegisterResponse* resp) {
+  uint64_t points = 0;
+  for (const auto& v : req->views()) points += uint64_t{v.cloud().width()} * v.cloud().height();
+  return RunHeavy(ctx, "Register", points, [this, ctx, req, resp, points](const std::atomic<bool>& cancel) {
+    if (req->views().empty()) return InvalidField("views", "at least one view is required");
+    if (points > config_.limits.max_points)
+      return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                          absl::StrCat("views: ", points, " points exceed the limit of ",
+                                       config_.limits.max_points));
+    auto filter = wire::FilterSettingsFromProto(req->filter_settings(), "filter_settings");
+    if (!filter.ok()) return FromCore(filter.status());
+    std::vector<ViewScan> views;
+    for (int i = 0; i < req->views_size(); ++i) {
+      const std::string field = absl::StrCat("views[", i, "]");
+      const v1::ViewScan& v = req->views(i);
+      auto pose = wire::TransformFromProto(v.world_from_sensor(), field + ".world_from_sensor");
+      if (!pose.ok()) return FromCore(pose.status());
+      auto cloud = wire::CloudFromProto(v.cloud(), field + ".cloud", config_.limits);
+      if (!cloud.ok()) return FromCore(cloud.status());
+      if (req->filter()) {
+        auto clusters = ClusterLinks(*cloud, *filter, &cancel);
+        if (!clusters.ok()) return FromCore(clusters.status());
+        auto cleaned = ApplyFilter(*cloud, *clusters);
+        if (!cleaned.ok()) return FromCore(cleaned.status());
+        cloud = std::move(cleaned);
+      }
+      views.push_back({v.name().empty() ? absl::StrCat("view", i) : v.name(), *std::move(cloud), *pose});
+    }
+    auto merged = RegisterToWorld(views);
+    if (!merged.ok()) return FromCore(merged.status());
+    if (req->best_fit()) {
+      auto world_from_part = wire::TransformFromProto(req->world_from_part(), "world_from_part");
+      if (!world_from_part.ok()) return FromCore(world_from_part.status());
+      std::shared_ptr<const MeshIndex> part;
+      if (grpc::Status st = ResolveMesh(ctx, req->part(), "part", &part); !st.ok()) return st;
+      auto fit = BestFitToCad(*part, *world_from_part, *merged, DefaultBestFitSettings(), &cancel);
+      if (!fit.ok()) return FromCore(fit.status());
+      merged->cloud_in_world = TransformCloud(merged->cloud_in_world, fit->correction);
+      wire::TransformToProto(fit->correction, resp->mutable_best_fit_correction());
+    }
+    wire::CloudToProto(merged->cloud_in_world, resp->mutable_merged());
+    resp->mutable_view_index()->assign(reinterpret_cast<const char*>(merged->view_id.data()),
+                                       merged->view_id.size() * sizeof(uint16_t));
+    resp->mutable_grid_index()->assign(reinterpret_cast<const char*>(merged->grid_index.data()),
+                                       merged->grid_index.size() * sizeof(uint32_t));
+    for (std::size_t n : merged->points_per_view) resp->add_points_per_view(n);
+    return grpc::Status::OK;
+  });
+}
+
+grpc::ServerUnaryReactor* InspectionService::ErrorMap(grpc::CallbackServerContext* ctx,
+                                                      const v1::ErrorMapRequest* req,
+                                                      v1::ErrorMapResponse* resp) {
+  const uint64_t points = uint64_t{req->cloud().width()} * req->cloud().height();
+  return RunHeavy(ctx, "ErrorMap", points, [this, ctx, req, resp](const std::atomic<bool>& cancel) {
+    auto cloud = wire::CloudFromProto(req->cloud(), "cloud", config_.limits);
+    if (!cloud.ok()) return FromCore(cloud.status());
+    auto world_from_part = wire::TransformFromProto(req->world_from_part(), "world_from_part");
+    if (!world_from_part.ok()) return FromCore(world_from_part.status());
+    auto settings = wire::ErrorMapSettingsFromProto(req->settings(), "settings");
+    if (!settings.ok()) return FromCore(settings.status());
+    std::shared_ptr<const MeshIndex> part;
+    if (grpc::Status st = ResolveMesh(ctx, req->part(), "part", &part); !st.ok()) return st;
+    auto map = ComputeErrorMap(*part, *cloud, *world_from_part, *settings, &cancel);
+    if (!map.ok()) return FromCore(map.status());
+    resp->set_report_json(ErrorMapReportText(*map, *settings));
+    resp->set_verdict(map->verdict.pass ? "pass" : "fail");
+    if (req->return_deviations()) resp->set_deviations(wire::PackFloats(map->deviation_mm));
+    if (req->return_png()) {
+      auto png = ErrorMapPngBytes(*cloud, *world_from_part, *map, part->mesh());
+      if (!png.ok()) return FromCore(png.status());
+      resp->set_png(*std::move(png));
+    }
+    return grpc::Status::OK;
+  });
+}
+
+}  // namespace surfinspect::server

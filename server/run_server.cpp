@@ -1,0 +1,106 @@
+#include "server/run_server.h"
+
+#include <grpcpp/ext/proto_server_reflection_plugin.h>
+#include <grpcpp/grpcpp.h>
+#include <grpcpp/health_check_service_interface.h>
+#include <signal.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cstdio>
+#include <thread>
+
+#include "absl/strings/str_cat.h"
+#include "core/atomic_file.h"
+
+namespace surfinspect::server {
+namespace {
+
+absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> Credentials(const ServerOptions& o) {
+  if (o.tls_cert_file.empty() && o.tls_key_file.empty()) {
+    if (!o.tls_client_ca_file.empty())
+      return absl::InvalidArgumentError("--tls-client-ca needs --tls-cert and --tls-key");
+    return grpc::InsecureServerCredentials();
+  }
+  if (o.tls_cert_file.empty() || o.tls_key_file.empty())
+    return absl::InvalidArgumentError("TLS needs both --tls-cert and --tls-key");
+  auto cert = ReadFileToString(o.tls_cert_file, 1 << 20);
+  if (!cert.ok()) return cert.status();
+  auto key = ReadFileToString(o.tls_key_file, 1 << 20);
+  if (!key.ok()) return key.status();
+  grpc::SslServerCredentialsOptions ssl;
+  ssl.pem_key_cert_pairs.push_back({*key, *cert});
+  if (!o.tls_client_ca_file.empty()) {
+    auto ca = ReadFileToString(o.tls_client_ca_file, 1 << 20);
+    if (!ca.ok()) return ca.status();
+    ssl.pem_root_certs = *ca;
+    ssl.client_certificate_request = GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY;
+  }
+  return grpc::SslServerCredentials(ssl);
+}
+
+}  // namespace
+
+absl::Status RunServer(const ServerOptions& o) {
+  if (o.max_message_mb < 1 || o.max_message_mb > 2000)
+    return absl::InvalidArgumentError("--max-message-mb must be in 1..2000");
+  if (o.service.threads < 1 || o.service.max_admitted_calls < 1)
+    return absl::InvalidArgumentError("--threads and --max-calls must be >= 1");
+  auto creds = Credentials(o);
+  if (!creds.ok()) return creds.status();
+  auto metrics = Metrics::Create(o.metrics_listen);
+  if (!metrics.ok()) return metrics.status();
+
+  // Handle SIGTERM/SIGINT on one thread of our own: they are blocked (main
+  // blocks them first thing; this repeats it for other callers), and the
+  // waiter below takes them with sigwait.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+
+  InspectionService service(o.service, metrics->get());
+  grpc::EnableDefaultHealthCheckService(true);
+  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+  grpc::ServerBuilder builder;
+  int port = 0;
+  builder.AddListeningPort(o.listen, *creds, &port);
+  builder.SetMaxReceiveMessageSize(o.max_message_mb << 20);
+  builder.SetMaxSendMessageSize(o.max_message_mb << 20);
+  if (o.max_connection_age_s > 0) {
+    builder.AddChannelArgument(GRPC_ARG_MAX_CONNECTION_AGE_MS, o.max_connection_age_s * 1000);
+    builder.AddChannelArgument(GRPC_ARG_MAX_CONNECTION_AGE_GRACE_MS, 30000);
+  }
+  builder.RegisterService(&service);
+  std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
+  if (!server || port == 0)
+    return absl::UnavailableError(absl::StrCat("cannot listen on ", o.listen));
+  grpc::HealthCheckServiceInterface* health = server->GetHealthCheckService();
+  health->SetServingStatus(true);
+  health->SetServingStatus("surfinspect.v1.InspectionService", true);
+
+  const std::string host = o.listen.substr(0, o.listen.rfind(':'));
+  std::printf("surfinspectd listening on %s:%d\n", host.c_str(), port);
+  std::fflush(stdout);
+  spdlog::info("serving on {}:{} ({} worker threads, {} admitted calls, TLS {}, token {}, metrics {})",
+               host, port, o.service.threads, o.service.max_admitted_calls,
+               o.tls_cert_file.empty() ? "off" : (o.tls_client_ca_file.empty() ? "on" : "mTLS"),
+               o.service.auth_token.empty() ? "off" : "on",
+               o.metrics_listen.empty() ? "off" : o.metrics_listen);
+
+  std::thread waiter([&] {
+    int sig = 0;
+    sigwait(&signals, &sig);
+    spdlog::info("signal {}: draining (up to {} s)", sig, o.drain_seconds);
+    health->Shutdown();  // NOT_SERVING for everyone, frozen
+    server->Shutdown(std::chrono::system_clock::now() +
+                     std::chrono::milliseconds(static_cast<int64_t>(o.drain_seconds * 1000)));
+  });
+  server->Wait();
+  waiter.join();
+  spdlog::info("stopped");
+  return absl::OkStatus();
+}
+
+}  // namespace surfinspect::server

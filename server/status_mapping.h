@@ -1,0 +1,16 @@
+// The one place core statuses become gRPC statuses. Core returns
+// absl::Status; no exception ever crosses an RPC boundary.
+#pragma once
+
+#include <grpcpp/support/status.h>
+
+#include "absl/status/status.h"
+
+namespace surfinspect::server {
+
+grpc::Status ToGrpc(const absl::Status& status);
+
+// For validation failures that name a request field.
+grpc::Status InvalidField(const std::string& field, const std::string& why);
+
+}  // namespace surfinspect::server

@@ -1,0 +1,509 @@
+// Integration tests: a real surfinspectd on a free loopback port, called
+// through the same RemoteClient the CLI and the cell-agent use.
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstring>
+#include <future>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "client/remote/remote_client.h"
+#include "core/calibration.h"
+#include "core/demo_cell.h"
+#include "core/inspection.h"
+#include "core/mesh_hash.h"
+#include "proto/convert.h"
+#include "tests/support/server_process.h"
+#include "tests/support/temp_dir.h"
+
+namespace surfinspect {
+namespace {
+
+using client::RemoteClient;
+using client::RemoteOptions;
+using Clock = std::chrono::steady_clock;
+
+struct Data {
+  DemoCell cell = MakeDemoCell();
+  PointCloud gauge_scan;                 // viewpoint v1, sensor frame
+  std::vector<ViewScan> views;           // three part scans with true poses
+  PointCloud merged_world;               // their merge (for ErrorMap)
+};
+
+const Data& TestData() {
+  static const Data* d = [] {
+    auto* data = new Data();
+    ScanOptions opt;
+    opt.noise_sigma_mm = 0.015;
+    opt.pulse_fraction = 0.003;
+    opt.stripes = true;
+    const DemoViewpoint& v1 = data->cell.viewpoints[0];
+    data->gauge_scan = SimulateScan(data->cell.gauge, v1.world_from_gauge, v1.world_from_sensor,
+                                    data->cell.intrinsics, opt)->cloud_in_sensor;
+    opt.defects = {SurfaceDefect{{-60, 5, 60 - 3 * 0.16}, 6, 0.2}};
+    for (int v = 0; v < 3; ++v) {
+      opt.seed = 7 + v;
+      const DemoViewpoint& vp = data->cell.viewpoints[v];
+      data->views.push_back({vp.name,
+                             SimulateScan(data->cell.part, data->cell.world_from_part, vp.world_from_sensor,
+                                          data->cell.intrinsics, opt)->cloud_in_sensor,
+                             vp.world_from_sensor});
+    }
+    data->merged_world = RegisterToWorld(data->views)->cloud_in_world;
+    return data;
+  }();
+  return *d;
+}
+
+std::unique_ptr<RemoteClient> ClientFor(const testing::ServerProcess& s, RemoteOptions o = {}) {
+  o.target = s.target();
+  if (o.timeout_s == 600) o.timeout_s = 60;
+  return *RemoteClient::Connect(o);
+}
+
+v1::ErrorMapRequest ErrorMapRequest(const PointCloud& cloud) {
+  v1::ErrorMapRequest req;
+  wire::CloudToProto(cloud, req.mutable_cloud());
+  wire::TransformToProto(TestData().cell.world_from_part, req.mutable_world_from_part());
+  req.set_return_deviations(true);
+  return req;
+}
+
+TEST(InspectionService, EveryRpcMatchesInProcess) {
+  testing::ServerProcess server;
+  ASSERT_TRUE(server.started());
+  auto client = ClientFor(server);
+  const Data& d = TestData();
+  EXPECT_EQ(*client->Health(), "SERVING");
+
+  // Filter: same grid, same kept points, bit for bit.
+  v1::FilterRequest freq;
+  wire::CloudToProto(d.views[0].cloud_in_sensor, freq.mutable_cloud());
+  auto fresp = client->Filter(freq);
+  ASSERT_TRUE(fresp.ok()) << fresp.status();
+  const PointCloud local_filtered =
+      *ApplyFilter(d.views[0].cloud_in_sensor, *ClusterLinks(d.views[0].cloud_in_sensor, {}));
+  ASSERT_EQ(fresp->cloud().xyz().size(), local_filtered.size() * 12);
+  EXPECT_EQ(0, std::memcmp(fresp->cloud().xyz().data(), local_filtered.points.data(), local_filtered.size() * 12));
+
+  // Calibrate: identical pose (first call sends the hash, gets
+  // MESH_NOT_CACHED and re-sends inline; the client hides that).
+  const DemoViewpoint& v1 = d.cell.viewpoints[0];
+  v1::CalibrateRequest creq;
+  wire::TransformToProto(v1.world_from_gauge, creq.mutable_world_from_gauge());
+  wire::TransformToProto(v1.nominal_world_from_sensor, creq.mutable_initial_world_from_sensor());
+  wire::CloudToProto(d.gauge_scan, creq.mutable_scan());
+  CalibrationSettings cs;
+  wire::IcpSettingsToProto(cs.icp, creq.mutable_icp());
+  auto cresp = client->Calibrate(creq, d.cell.gauge);
+  ASSERT_TRUE(cresp.ok()) << cresp.status();
+  auto gauge_index = *MeshIndex::Build(d.cell.gauge);
+  const CalibrationResult local_cal =
+      *CalibrateViewpoint(*gauge_index, v1.world_from_gauge, d.gauge_scan, v1.nominal_world_from_sensor, cs);
+  EXPECT_TRUE((wire::TransformFromProto(cresp->world_from_sensor(), "w")->matrix() -
+               local_cal.world_from_sensor.matrix()).cwiseAbs().maxCoeff() < 1e-12);
+
+  // Register: the same merged points.
+  v1::RegisterRequest rreq;
+  for (const auto& v : d.views) {
+    v1::ViewScan* s = rreq.add_views();
+    s->set_name(v.name);
+    wire::TransformToProto(v.world_from_sensor, s->mutable_world_from_sensor());
+    wire::CloudToProto(v.cloud_in_sensor, s->mutable_cloud());
+  }
+  auto rresp = client->Register(rreq, nullptr);
+  ASSERT_TRUE(rresp.ok()) << rresp.status();
+  ASSERT_EQ(rresp->merged().width(), d.merged_world.size());
+  EXPECT_EQ(0, std::memcmp(rresp->merged().xyz().data(), d.merged_world.points.data(), d.merged_world.size() * 12));
+
+  // ErrorMap: same deviations, same report apart from timing.
+  auto eresp = client->ErrorMap(ErrorMapRequest(d.merged_world), d.cell.part);
+  ASSERT_TRUE(eresp.ok()) << eresp.status();
+  auto part_index = *MeshIndex::Build(d.cell.part);
+  const ErrorMapResult local_map = *ComputeErrorMap(*part_index, d.merged_world, d.cell.world_from_part, {});
+  const std::vector<float> remote_dev = wire::UnpackFloats(eresp->deviations());
+  ASSERT_EQ(remote_dev.size(), local_map.deviation_mm.size());
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < remote_dev.size(); ++i)
+    differing += std::memcmp(&remote_dev[i], &local_map.deviation_mm[i], 4) != 0;
+  EXPECT_EQ(differing, 0u);
+  nlohmann::json remote_report = nlohmann::json::parse(eresp->report_json());
+  nlohmann::json local_report = nlohmann::json::parse(ErrorMapReportText(local_map, {}));
+  remote_report.erase("timing");
+  local_report.erase("timing");
+  EXPECT_EQ(remote_report, local_report);
+
+  // Inspect (stream): same verdict and deviations as InspectPart.
+  v1::PartHeader header;
+  header.set_part_id("p1");
+  wire::TransformToProto(d.cell.world_from_part, header.mutable_world_from_part());
+  header.set_return_deviations(true);
+  header.set_return_png(true);
+  std::vector<std::string> stages;
+  auto iresp = client->Inspect(header, d.cell.part, d.views, [&](const v1::Progress& p) {
+    stages.push_back(v1::Progress::Stage_Name(p.stage()));
+  });
+  ASSERT_TRUE(iresp.ok()) << iresp.status();
+  const InspectionResult local = *InspectPart(*part_index, d.cell.world_from_part, d.views, {});
+  EXPECT_TRUE(iresp->deviations() == wire::PackFloats(local.error_map.deviation_mm));
+  EXPECT_EQ(iresp->verdict(), local.error_map.verdict.pass ? "pass" : "fail");
+  EXPECT_EQ(iresp->png().substr(1, 3), "PNG");
+  EXPECT_EQ(std::count(stages.begin(), stages.end(), "STAGE_VIEW_RECEIVED"), 3);
+  EXPECT_EQ(std::count(stages.begin(), stages.end(), "STAGE_VIEW_FILTERED"), 3);
+  EXPECT_EQ(std::count(stages.begin(), stages.end(), "STAGE_ERROR_MAP"), 1);
+}
+
+// Raw stub calls, so malformed requests reach the server as they are.
+class RawCalls {
+ public:
+  explicit RawCalls(const std::string& target)
+      : stub_(v1::InspectionService::NewStub(grpc::CreateChannel(target, grpc::InsecureChannelCredentials()))) {}
+  template <typename Req, typename Resp, typename Fn>
+  grpc::Status Call(Fn fn, const Req& req) {
+    grpc::ClientContext ctx;
+    ctx.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
+    Resp resp;
+    return ((*stub_).*fn)(&ctx, req, &resp);
+  }
+  grpc::Status Inspect(const std::vector<v1::InspectRequest>& msgs) {
+    grpc::ClientContext ctx;
+    ctx.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
+    auto stream = stub_->Inspect(&ctx);
+    for (const auto& m : msgs)
+      if (!stream->Write(m)) break;
+    stream->WritesDone();
+    v1::InspectResponse r;
+    while (stream->Read(&r)) {
+    }
+    return stream->Finish();
+  }
+  std::unique_ptr<v1::InspectionService::Stub> stub_;
+};
+
+TEST(InspectionService, BadRequestsGetTheRightCodeAndTheServerStaysUp) {
+  testing::ServerProcess server({"--max-points", "2000000", "--max-triangles", "100000"});
+  ASSERT_TRUE(server.started());
+  RawCalls raw(server.target());
+  using S = v1::InspectionService::Stub;
+  using grpc::StatusCode;
+  const Data& d = TestData();
+  v1::InlineMesh good_mesh;
+  wire::MeshToProto(d.cell.part, &good_mesh);
+  auto cloud = [](uint32_t w, uint32_t h, std::size_t bytes, float fill = 1.f) {
+    v1::PointCloud c;
+    c.set_width(w);
+    c.set_height(h);
+    std::vector<float> v(bytes / 4, fill);
+    c.set_xyz(std::string(reinterpret_cast<const char*>(v.data()), bytes));
+    return c;
+  };
+  std::vector<std::pair<std::string, std::pair<grpc::Status, StatusCode>>> cases;
+  auto filter = [&](const v1::PointCloud& c, const v1::FilterSettings& s = {}) {
+    v1::FilterRequest r;
+    *r.mutable_cloud() = c;
+    *r.mutable_settings() = s;
+    return raw.Call<v1::FilterRequest, v1::FilterResponse>(&S::Filter, r);
+  };
+  cases.push_back({"empty cloud", {filter(cloud(0, 0, 0)), StatusCode::INVALID_ARGUMENT}});
+  cases.push_back({"truncated xyz", {filter(cloud(10, 10, 1000)), StatusCode::INVALID_ARGUMENT}});
+  cases.push_back({"inf coordinate", {filter(cloud(4, 4, 192, INFINITY)), StatusCode::INVALID_ARGUMENT}});
+  cases.push_back({"too many points", {filter(cloud(5000, 5000, 12)), StatusCode::RESOURCE_EXHAUSTED}});
+  v1::FilterSettings neg;
+  neg.set_link_distance_mm(-1);
+  cases.push_back({"negative link distance", {filter(cloud(4, 4, 192), neg), StatusCode::INVALID_ARGUMENT}});
+  v1::FilterSettings nan_link;
+  nan_link.set_link_distance_mm(NAN);
+  cases.push_back({"NaN link distance", {filter(cloud(4, 4, 192), nan_link), StatusCode::INVALID_ARGUMENT}});
+  v1::FilterSettings conn;
+  conn.set_connectivity(6);
+  cases.push_back({"connectivity 6", {filter(cloud(4, 4, 192), conn), StatusCode::INVALID_ARGUMENT}});
+
+  auto errormap = [&](v1::ErrorMapRequest r) {
+    return raw.Call<v1::ErrorMapRequest, v1::ErrorMapResponse>(&S::ErrorMap, r);
+  };
+  v1::ErrorMapRequest em;
+  *em.mutable_cloud() = cloud(4, 4, 192);
+  wire::TransformToProto(Eigen::Isometry3d::Identity(), em.mutable_world_from_part());
+  *em.mutable_part()->mutable_inline_() = good_mesh;
+  v1::ErrorMapRequest no_mesh = em;
+  no_mesh.clear_part();
+  cases.push_back({"missing mesh", {errormap(no_mesh), StatusCode::INVALID_ARGUMENT}});
+  v1::ErrorMapRequest unknown_hash = em;
+  unknown_hash.mutable_part()->set_sha256(std::string(64, 'a'));
+  cases.push_back({"unknown mesh hash", {errormap(unknown_hash), StatusCode::FAILED_PRECONDITION}});
+  v1::ErrorMapRequest short_transform = em;
+  short_transform.mutable_world_from_part()->mutable_row_major()->RemoveLast();
+  cases.push_back({"15-value transform", {errormap(short_transform), StatusCode::INVALID_ARGUMENT}});
+  v1::ErrorMapRequest scaled = em;
+  scaled.mutable_world_from_part()->set_row_major(0, 2.0);
+  cases.push_back({"non-rigid transform", {errormap(scaled), StatusCode::INVALID_ARGUMENT}});
+  v1::ErrorMapRequest bad_index = em;
+  std::string tris = bad_index.part().inline_().triangles();
+  const uint32_t huge = 999999999;
+  std::memcpy(tris.data(), &huge, 4);
+  bad_index.mutable_part()->mutable_inline_()->set_triangles(tris);
+  cases.push_back({"triangle index out of range", {errormap(bad_index), StatusCode::INVALID_ARGUMENT}});
+  v1::ErrorMapRequest degenerate = em;
+  std::string verts(36, '\0');
+  degenerate.mutable_part()->mutable_inline_()->set_vertices(verts);
+  degenerate.mutable_part()->mutable_inline_()->set_triangles(std::string("\0\0\0\0\1\0\0\0\2\0\0\0", 12));
+  cases.push_back({"only degenerate triangles", {errormap(degenerate), StatusCode::INVALID_ARGUMENT}});
+  v1::ErrorMapRequest ragged = em;
+  ragged.mutable_part()->mutable_inline_()->set_vertices("12345");
+  cases.push_back({"ragged vertex bytes", {errormap(ragged), StatusCode::INVALID_ARGUMENT}});
+  v1::ErrorMapRequest neg_tol = em;
+  neg_tol.mutable_settings()->set_tolerance_mm(-0.1);
+  cases.push_back({"negative tolerance", {errormap(neg_tol), StatusCode::INVALID_ARGUMENT}});
+
+  v1::CalibrateRequest cal;
+  *cal.mutable_scan() = cloud(4, 4, 192);
+  wire::TransformToProto(Eigen::Isometry3d::Identity(), cal.mutable_world_from_gauge());
+  cases.push_back({"calibrate without initial pose",
+                   {raw.Call<v1::CalibrateRequest, v1::CalibrateResponse>(&S::Calibrate, cal),
+                    StatusCode::INVALID_ARGUMENT}});
+  cases.push_back({"register without views",
+                   {raw.Call<v1::RegisterRequest, v1::RegisterResponse>(&S::Register, v1::RegisterRequest{}),
+                    StatusCode::INVALID_ARGUMENT}});
+
+  v1::InspectRequest part_msg, view_msg, chunk_msg, end_msg;
+  part_msg.mutable_part()->set_part_id("x");
+  *part_msg.mutable_part()->mutable_part()->mutable_inline_() = good_mesh;
+  wire::TransformToProto(Eigen::Isometry3d::Identity(), part_msg.mutable_part()->mutable_world_from_part());
+  view_msg.mutable_view()->set_name("v1");
+  view_msg.mutable_view()->set_width(2);
+  view_msg.mutable_view()->set_height(2);
+  wire::TransformToProto(Eigen::Isometry3d::Identity(), view_msg.mutable_view()->mutable_world_from_sensor());
+  chunk_msg.mutable_chunk()->set_xyz(std::string(24, '\0'));
+  end_msg.mutable_end();
+  cases.push_back({"inspect: view before part", {raw.Inspect({view_msg}), StatusCode::INVALID_ARGUMENT}});
+  cases.push_back({"inspect: truncated view", {raw.Inspect({part_msg, view_msg, chunk_msg, end_msg}),
+                                               StatusCode::INVALID_ARGUMENT}});
+  cases.push_back({"inspect: no end marker", {raw.Inspect({part_msg}), StatusCode::INVALID_ARGUMENT}});
+  cases.push_back({"inspect: too many bytes", {raw.Inspect({part_msg, view_msg, chunk_msg, chunk_msg, chunk_msg}),
+                                               StatusCode::INVALID_ARGUMENT}});
+
+  ASSERT_GE(cases.size(), 15u);
+  for (const auto& [name, c] : cases) {
+    EXPECT_EQ(c.first.error_code(), c.second) << name << ": " << c.first.error_message();
+    EXPECT_FALSE(c.first.error_message().empty()) << name;
+  }
+  auto client = ClientFor(server);
+  EXPECT_EQ(*client->Health(), "SERVING");
+}
+
+TEST(InspectionService, CancelledAndDeadlineExceededCallsStopPromptly) {
+  // One worker: if a cancelled call kept computing, the next call would
+  // queue behind it.
+  testing::ServerProcess server({"--threads", "1"});
+  ASSERT_TRUE(server.started());
+  const Data& d = TestData();
+  // A large cloud: the merged part, four times.
+  PointCloud big = d.merged_world;
+  for (int k = 0; k < 3; ++k)
+    big.points.insert(big.points.end(), d.merged_world.points.begin(), d.merged_world.points.end());
+  big.width = static_cast<uint32_t>(big.size());
+  auto client = ClientFor(server);
+  const auto t0 = Clock::now();
+  ASSERT_TRUE(client->ErrorMap(ErrorMapRequest(big), d.cell.part).ok());
+  const double full_s = std::chrono::duration<double>(Clock::now() - t0).count();
+
+  v1::FilterRequest small;
+  wire::CloudToProto(d.views[0].cloud_in_sensor, small.mutable_cloud());
+  for (const bool use_deadline : {true, false}) {
+    grpc::ClientContext ctx;
+    if (use_deadline) ctx.set_deadline(std::chrono::system_clock::now() + std::chrono::milliseconds(150));
+    v1::ErrorMapRequest req = ErrorMapRequest(big);
+    req.mutable_part()->set_sha256(MeshSha256(d.cell.part));  // cached by the first call
+    v1::ErrorMapResponse resp;
+    auto stub = v1::InspectionService::NewStub(grpc::CreateChannel(server.target(), grpc::InsecureChannelCredentials()));
+    std::thread canceller;
+    if (!use_deadline)
+      canceller = std::thread([&] {
+        std::this_thread::sleep_for(std::chrono::milliseconds(150));
+        ctx.TryCancel();
+      });
+    const grpc::Status st = stub->ErrorMap(&ctx, req, &resp);
+    if (canceller.joinable()) canceller.join();
+    EXPECT_EQ(st.error_code(), use_deadline ? grpc::StatusCode::DEADLINE_EXCEEDED : grpc::StatusCode::CANCELLED);
+    // The worker must be free again at once: a small call right after
+    // finishes far sooner than the rest of the big one would have taken.
+    const auto t1 = Clock::now();
+    ASSERT_TRUE(client->Filter(small).ok());
+    const double after_s = std::chrono::duration<double>(Clock::now() - t1).count();
+    EXPECT_LT(after_s, std::max(0.5, 0.5 * full_s)) << "full " << full_s << " s";
+  }
+}
+
+TEST(InspectionService, EightClientsTwentyMixedCallsNoErrors) {
+  testing::ServerProcess server;
+  ASSERT_TRUE(server.started());
+  const Data& d = TestData();
+  v1::FilterRequest freq;
+  wire::CloudToProto(d.views[1].cloud_in_sensor, freq.mutable_cloud());
+  std::vector<std::future<int>> clients;
+  for (int c = 0; c < 8; ++c)
+    clients.push_back(std::async(std::launch::async, [&, c] {
+      auto client = ClientFor(server);
+      int errors = 0;
+      for (int k = 0; k < 20; ++k) {
+        absl::Status st;
+        switch ((c + k) % 3) {
+          case 0: st = client->Filter(freq).status(); break;
+          case 1: st = client->ErrorMap(ErrorMapRequest(d.views[2].cloud_in_sensor), d.cell.part).status(); break;
+          default: st = client->Health().status(); break;
+        }
+        errors += st.ok() ? 0 : 1;
+      }
+      return errors;
+    }));
+  int errors = 0;
+  for (auto& f : clients) errors += f.get();
+  EXPECT_EQ(errors, 0);
+}
+
+TEST(InspectionService, GracefulShutdownFinishesTheCallInFlight) {
+  testing::ServerProcess server({"--threads", "1", "--drain-seconds", "20"});
+  ASSERT_TRUE(server.started());
+  const Data& d = TestData();
+  auto client = ClientFor(server);
+  ASSERT_TRUE(client->Health().ok());
+  v1::PartHeader header;
+  header.set_part_id("drain");
+  wire::TransformToProto(d.cell.world_from_part, header.mutable_world_from_part());
+  auto call = std::async(std::launch::async, [&] { return client->Inspect(header, d.cell.part, d.views); });
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const auto t0 = Clock::now();
+  const int exit_code = server.Terminate();
+  const auto result = call.get();
+  EXPECT_TRUE(result.ok()) << result.status();
+  EXPECT_EQ(exit_code, 0);
+  EXPECT_LT(std::chrono::duration<double>(Clock::now() - t0).count(), 20.0);
+}
+
+TEST(InspectionService, BearerToken) {
+  testing::TempDir dir;
+  testing::WriteBytes(dir.File("token"), "s3cret-token\n");
+  testing::ServerProcess server({"--auth-token-file", dir.File("token")});
+  ASSERT_TRUE(server.started());
+  v1::FilterRequest req;
+  wire::CloudToProto(TestData().views[0].cloud_in_sensor, req.mutable_cloud());
+  auto anonymous = ClientFor(server);
+  EXPECT_EQ(anonymous->Filter(req).status().code(), absl::StatusCode::kUnauthenticated);
+  RemoteOptions wrong;
+  wrong.auth_token = "guess";
+  EXPECT_EQ(ClientFor(server, wrong)->Filter(req).status().code(), absl::StatusCode::kUnauthenticated);
+  RemoteOptions right;
+  right.auth_token = "s3cret-token";
+  EXPECT_TRUE(ClientFor(server, right)->Filter(req).ok());
+  // Health stays open for probes that carry no token.
+  EXPECT_EQ(*anonymous->Health(), "SERVING");
+
+  testing::ServerProcess open_server;  // token off
+  ASSERT_TRUE(open_server.started());
+  EXPECT_TRUE(ClientFor(open_server)->Filter(req).ok());
+}
+
+TEST(InspectionService, TlsWithAGeneratedCertificate) {
+  testing::TempDir dir;
+  const std::string cmd =
+      "cd " + dir.path() +
+      " && openssl req -x509 -newkey rsa:2048 -nodes -days 2 -subj /CN=surfinspect-test-ca"
+      " -keyout ca.key -out ca.crt >/dev/null 2>&1"
+      " && openssl req -newkey rsa:2048 -nodes -subj /CN=localhost -keyout server.key -out server.csr >/dev/null 2>&1"
+      " && printf 'subjectAltName=DNS:localhost,IP:127.0.0.1\\n' > san.ext"
+      " && openssl x509 -req -in server.csr -CA ca.crt -CAkey ca.key -CAcreateserial -days 2"
+      " -extfile san.ext -out server.crt >/dev/null 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << "openssl failed";
+  testing::ServerProcess server({"--tls-cert", dir.File("server.crt"), "--tls-key", dir.File("server.key")});
+  ASSERT_TRUE(server.started());
+  RemoteOptions tls;
+  tls.tls_ca_file = dir.File("ca.crt");
+  tls.timeout_s = 10;
+  v1::FilterRequest req;
+  wire::CloudToProto(TestData().views[0].cloud_in_sensor, req.mutable_cloud());
+  EXPECT_TRUE(ClientFor(server, tls)->Filter(req).ok());
+  RemoteOptions plain;
+  plain.timeout_s = 3;
+  EXPECT_FALSE(ClientFor(server, plain)->Filter(req).ok());
+}
+
+TEST(InspectionService, OverAdmissionIsResourceExhaustedNotACrash) {
+  testing::ServerProcess server({"--threads", "1", "--max-calls", "1"});
+  ASSERT_TRUE(server.started());
+  const Data& d = TestData();
+  std::vector<std::future<absl::Status>> calls;
+  for (int k = 0; k < 4; ++k)
+    calls.push_back(std::async(std::launch::async, [&] {
+      return ClientFor(server)->ErrorMap(ErrorMapRequest(d.merged_world), d.cell.part).status();
+    }));
+  int ok = 0, exhausted = 0;
+  for (auto& c : calls) {
+    const absl::Status st = c.get();
+    ok += st.ok();
+    exhausted += absl::IsResourceExhausted(st);
+  }
+  EXPECT_GE(ok, 1);
+  EXPECT_GE(exhausted, 1);
+  EXPECT_EQ(ok + exhausted, 4);
+  EXPECT_EQ(*ClientFor(server)->Health(), "SERVING");
+}
+
+// GET http://127.0.0.1:PORT/metrics with a plain socket.
+std::string HttpGet(int port, const std::string& path) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<uint16_t>(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  std::string out;
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)) == 0) {
+    const std::string req = "GET " + path + " HTTP/1.0\r\nHost: localhost\r\n\r\n";
+    if (::write(fd, req.data(), req.size()) == static_cast<ssize_t>(req.size())) {
+      char buf[4096];
+      ssize_t n;
+      while ((n = ::read(fd, buf, sizeof(buf))) > 0) out.append(buf, static_cast<std::size_t>(n));
+    }
+  }
+  ::close(fd);
+  return out;
+}
+
+int FreePort() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr));
+  socklen_t len = sizeof(addr);
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
+  ::close(fd);
+  return ntohs(addr.sin_port);
+}
+
+TEST(InspectionService, PrometheusMetricsCountCallsPointsAndCache) {
+  const int metrics_port = FreePort();
+  testing::ServerProcess server({"--metrics-listen", "127.0.0.1:" + std::to_string(metrics_port)});
+  ASSERT_TRUE(server.started());
+  const Data& d = TestData();
+  auto client = ClientFor(server);
+  ASSERT_TRUE(client->ErrorMap(ErrorMapRequest(d.views[0].cloud_in_sensor), d.cell.part).ok());
+  ASSERT_TRUE(client->ErrorMap(ErrorMapRequest(d.views[0].cloud_in_sensor), d.cell.part).ok());
+  v1::FilterRequest bad;
+  EXPECT_FALSE(client->Filter(bad).ok());
+  const std::string text = HttpGet(metrics_port, "/metrics");
+  EXPECT_NE(text.find("surfinspect_rpcs_total{code=\"OK\",method=\"ErrorMap\"} 2"), std::string::npos) << text;
+  EXPECT_NE(text.find("surfinspect_rpcs_total{code=\"INVALID_ARGUMENT\",method=\"Filter\"} 1"), std::string::npos);
+  EXPECT_NE(text.find("surfinspect_mesh_cache_lookups_total{result=\"hit\"} 1"), std::string::npos);
+  EXPECT_NE(text.find("surfinspect_rpc_duration_seconds_count{method=\"ErrorMap\"} 3"), std::string::npos);
+  EXPECT_NE(text.find("surfinspect_points_processed_total " + std::to_string(2 * d.views[0].cloud_in_sensor.size())),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace surfinspect
