@@ -1,7 +1,8 @@
 // RemoteClient: the client side of surfinspect.v1, shared by the CLI's
 // --server mode and the cell-agent. It owns the channel (TLS, bearer token,
-// round_robin over several replicas), sends meshes by content hash and
-// re-sends them inline when a replica answers MESH_NOT_CACHED, streams whole
+// round_robin over several replicas), sends a mesh inline when it is small
+// next to the call's clouds (at most 1/8 of their bytes), else by content
+// hash, re-sent inline when a replica answers MESH_NOT_CACHED; streams whole
 // parts in ~1 MB chunks, and maps gRPC statuses back to absl statuses.
 #pragma once
 
@@ -45,7 +46,8 @@ class RemoteClient {
   static absl::StatusOr<std::unique_ptr<RemoteClient>> Connect(const RemoteOptions& options);
 
   absl::StatusOr<v1::FilterResponse> Filter(const v1::FilterRequest& request);
-  // `gauge`/`part` fill the request's mesh: by hash first, inline on a miss.
+  // `gauge`/`part` fill the request's mesh: inline when small, else by hash
+  // first and inline on a miss.
   absl::StatusOr<v1::CalibrateResponse> Calibrate(v1::CalibrateRequest request,
                                                   const TriangleMesh& gauge);
   absl::StatusOr<v1::RegisterResponse> Register(v1::RegisterRequest request,

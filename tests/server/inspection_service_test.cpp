@@ -92,8 +92,8 @@ TEST(InspectionService, EveryRpcMatchesInProcess) {
   ASSERT_EQ(fresp->cloud().xyz().size(), local_filtered.size() * 12);
   EXPECT_EQ(0, std::memcmp(fresp->cloud().xyz().data(), local_filtered.points.data(), local_filtered.size() * 12));
 
-  // Calibrate: identical pose (first call sends the hash, gets
-  // MESH_NOT_CACHED and re-sends inline; the client hides that).
+  // Calibrate: identical pose (the gauge mesh is small next to the scan,
+  // so the client sends it inline).
   const DemoViewpoint& v1 = d.cell.viewpoints[0];
   v1::CalibrateRequest creq;
   wire::TransformToProto(v1.world_from_gauge, creq.mutable_world_from_gauge());
@@ -492,8 +492,12 @@ TEST(InspectionService, PrometheusMetricsCountCallsPointsAndCache) {
   ASSERT_TRUE(server.started());
   const Data& d = TestData();
   auto client = ClientFor(server);
-  ASSERT_TRUE(client->ErrorMap(ErrorMapRequest(d.views[0].cloud_in_sensor), d.cell.part).ok());
-  ASSERT_TRUE(client->ErrorMap(ErrorMapRequest(d.views[0].cloud_in_sensor), d.cell.part).ok());
+  // A cloud much smaller than the mesh, so the client sends the mesh by hash
+  // (a miss, then inline), then by hash again (a hit).
+  const PointCloud small = PointCloud::Unorganized(
+      std::vector<Eigen::Vector3f>(d.merged_world.points.begin(), d.merged_world.points.begin() + 500));
+  ASSERT_TRUE(client->ErrorMap(ErrorMapRequest(small), d.cell.part).ok());
+  ASSERT_TRUE(client->ErrorMap(ErrorMapRequest(small), d.cell.part).ok());
   v1::FilterRequest bad;
   EXPECT_FALSE(client->Filter(bad).ok());
   const std::string text = HttpGet(metrics_port, "/metrics");
@@ -501,7 +505,7 @@ TEST(InspectionService, PrometheusMetricsCountCallsPointsAndCache) {
   EXPECT_NE(text.find("surfinspect_rpcs_total{code=\"INVALID_ARGUMENT\",method=\"Filter\"} 1"), std::string::npos);
   EXPECT_NE(text.find("surfinspect_mesh_cache_lookups_total{result=\"hit\"} 1"), std::string::npos);
   EXPECT_NE(text.find("surfinspect_rpc_duration_seconds_count{method=\"ErrorMap\"} 3"), std::string::npos);
-  EXPECT_NE(text.find("surfinspect_points_processed_total " + std::to_string(2 * d.views[0].cloud_in_sensor.size())),
+  EXPECT_NE(text.find("surfinspect_points_processed_total " + std::to_string(2 * small.size())),
             std::string::npos);
 }
 

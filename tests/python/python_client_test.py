@@ -1,0 +1,249 @@
+#!/usr/bin/env python3
+"""The Python client for MES integrators (client/python) against a real
+surfinspectd: stubs generated from the proto with Debian's tools, the example
+script's verdict and report equal to the C++ CLI's for the same part, the
+mesh hash equal to the C++ one (a hash-only call hits the mesh the C++ client
+cached), the token enforced, and bad input rejected with a clear message.
+Its PCD and STL readers are checked on small hand-made files.
+
+Run with Debian's /usr/bin/python3 (python3-grpcio, python3-protobuf).
+usage: python_client_test.py BIN_DIR SOURCE_DIR [unittest args]
+"""
+import json
+import math
+import os
+import re
+import shutil
+import socket
+import struct
+import subprocess
+import sys
+import tempfile
+import unittest
+import urllib.request
+
+BIN = SRC = None
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class Server:
+    def __init__(self, *extra):
+        self.metrics_port = free_port()
+        self.proc = subprocess.Popen(
+            [os.path.join(BIN, "surfinspectd"), "--listen", "127.0.0.1:0", "--threads", "2",
+             "--metrics-listen", f"127.0.0.1:{self.metrics_port}", *extra],
+            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+        line = self.proc.stdout.readline()
+        self.proc.stdout.close()
+        assert "listening on" in line, f"server did not start: {line!r}"
+        self.target = line.split()[-1]
+
+    def rpcs(self, method, codes):
+        """surfinspect_rpcs_total for `method` summed over `codes`."""
+        with urllib.request.urlopen(f"http://127.0.0.1:{self.metrics_port}/metrics", timeout=5) as r:
+            text = r.read().decode()
+        total = 0.0
+        for code, m, value in re.findall(r'^surfinspect_rpcs_total\{code="([^"]*)",method="(\w+)"\} (\S+)$',
+                                         text, re.M):
+            if m == method and code in codes:
+                total += float(value)
+        return total
+
+    def stop(self):
+        # SIGKILL: graceful drain is tested elsewhere, and stopping the
+        # metrics listener gracefully takes ~2 s.
+        if self.proc.poll() is None:
+            self.proc.kill()
+            self.proc.wait(timeout=30)
+
+
+# The server labels Inspect's codes by number, the unary methods by name.
+FAILED_PRECONDITION = ("FAILED_PRECONDITION", "9")
+
+
+class PythonClientTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.root = tempfile.mkdtemp(prefix="py-client-")
+        cls.gen = os.path.join(cls.root, "gen")
+        subprocess.run([os.path.join(SRC, "client", "python", "generate.sh"), cls.gen], check=True,
+                       stdout=subprocess.DEVNULL)
+        sys.path[:0] = [cls.gen, os.path.join(SRC, "client", "python")]
+        cls.token = os.path.join(cls.root, "token")
+        with open(cls.token, "w") as f:
+            f.write("py-client-test-token\n")
+        subprocess.run([os.path.join(BIN, "surfinspect"), "demo-cell", "--out", os.path.join(cls.root, "cell"),
+                        "--parts", "1"], check=True, stdout=subprocess.DEVNULL)
+        cls.cell = os.path.join(cls.root, "cell", "cell.json")
+        cls.scans = os.path.join(cls.root, "cell", "scans", "part-001")
+        server = Server("--auth-token-file", cls.token)
+        try:
+            out = subprocess.run([os.path.join(BIN, "cell-agent"), "calibrate", "--cell", cls.cell, "--server",
+                                  server.target, "--token-file", cls.token],
+                                 check=True, capture_output=True, text=True).stdout
+        finally:
+            server.stop()
+        assert "calibrated 5 of 5" in out, out
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.root, ignore_errors=True)
+
+    def setUp(self):
+        self.server = None
+
+    def tearDown(self):
+        if self.server:
+            self.server.stop()
+
+    def example(self, *args, cell=None, scans=None, server=None):
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join([self.gen, os.path.join(SRC, "client", "python")]))
+        cmd = [sys.executable, os.path.join(SRC, "client", "python", "inspect_part.py"),
+               "--cell", cell or self.cell, "--scans", scans or self.scans,
+               "--server", server or self.server.target, *args]
+        return subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=120)
+
+    def test_stubs_are_generated_from_the_proto(self):
+        for f in ("inspection_pb2.py", "inspection_pb2_grpc.py"):
+            self.assertTrue(os.path.exists(os.path.join(self.gen, "surfinspect", "v1", f)), f)
+        from surfinspect.v1 import inspection_pb2_grpc
+        self.assertTrue(hasattr(inspection_pb2_grpc, "InspectionServiceStub"))
+
+    def test_example_matches_the_cpp_cli_and_its_mesh_hash(self):
+        self.server = Server("--auth-token-file", self.token)
+        out_dir = os.path.join(self.root, "cpp-out")
+        # The C++ CLI first: its (small) part mesh goes inline and the server
+        # caches it under the hash it computes itself.
+        subprocess.run([os.path.join(BIN, "surfinspect"), "inspect", "--cell", self.cell, "--scans", self.scans,
+                        "--out", out_dir, "--server", self.server.target, "--token-file", self.token],
+                       check=True, capture_output=True, text=True)
+        self.assertEqual(self.server.rpcs("Inspect", FAILED_PRECONDITION), 0)
+        # Python by hash only: a hit, so the Python mesh and hash equal C++'s.
+        report_path = os.path.join(self.root, "py-report.json")
+        r = self.example("--token-file", self.token, "--mesh", "hash", "--report", report_path)
+        self.assertIn(r.returncode, (0, 1), r.stderr)
+        self.assertEqual(self.server.rpcs("Inspect", FAILED_PRECONDITION), 0,
+                         "the Python client's mesh hash differs from the C++ client's")
+        self.assertEqual(self.server.rpcs("Inspect", ("OK",)), 2)
+        with open(report_path) as f:
+            py = json.load(f)
+        with open(os.path.join(out_dir, "report.json")) as f:
+            cpp = json.load(f)
+        py.pop("timing", None)
+        cpp.pop("timing", None)
+        self.assertEqual(py, cpp)
+        verdict = cpp["tolerance"]["verdict"]
+        self.assertEqual(r.returncode, 0 if verdict == "pass" else 1)
+        self.assertRegex(r.stdout, rf"^part-001 {verdict}  min [-+]\d+\.\d{{3}} mm  max [-+]\d+\.\d{{3}} mm$")
+        self.assertIn(f"{cpp['statistics']['max_mm']:+.3f}", r.stdout)
+
+    def test_hash_miss_falls_back_to_inline(self):
+        self.server = Server()
+        r = self.example("--mesh", "hash")
+        self.assertIn(r.returncode, (0, 1), r.stderr)
+        self.assertEqual(self.server.rpcs("Inspect", FAILED_PRECONDITION), 1)
+        self.assertEqual(self.server.rpcs("Inspect", ("OK",)), 1)
+        r = self.example()  # auto: this mesh is small next to the clouds, inline
+        self.assertIn(r.returncode, (0, 1), r.stderr)
+        self.assertEqual(self.server.rpcs("Inspect", FAILED_PRECONDITION), 1)
+
+    def test_token_is_required(self):
+        self.server = Server("--auth-token-file", self.token)
+        r = self.example()
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("UNAUTHENTICATED", r.stderr)
+        self.assertNotIn("Traceback", r.stderr)
+
+    def test_bad_input_is_rejected_clearly(self):
+        self.server = Server()
+        bad = os.path.join(self.root, "bad-part")
+        shutil.copytree(self.scans, bad)
+        with open(os.path.join(bad, "v2.pcd"), "r+b") as f:
+            f.truncate(os.path.getsize(os.path.join(bad, "v2.pcd")) // 2)
+        r = self.example(scans=bad)
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("truncated", r.stderr)
+        # The cell before calibration has no world_from_sensor.
+        r = self.example(cell=self.cell + ".bak")
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("not calibrated", r.stderr)
+        empty = os.path.join(self.root, "empty-part")
+        os.makedirs(empty, exist_ok=True)
+        r = self.example(scans=empty)
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("no <viewpoint>.pcd", r.stderr)
+        # Nobody listening: the deadline, not a hang.
+        r = self.example("--timeout", "2", server=f"127.0.0.1:{free_port()}")
+        self.assertEqual(r.returncode, 2)
+        self.assertRegex(r.stderr, "DEADLINE_EXCEEDED|UNAVAILABLE")
+        self.assertEqual(self.server.rpcs("Inspect", ("OK",)), 0)
+
+    def test_pcd_reader_ascii_binary_and_interleaved_fields(self):
+        import surfinspect_client as sc
+        pts = [(1.5, -2.25, 300.0), (math.nan, math.nan, math.nan), (0.125, 4.0, -7.5)]
+        expect = b"".join(struct.pack("<3f", *p) for p in pts)
+
+        def header(fields, size, typ, count, encoding):
+            return (f"VERSION 0.7\nFIELDS {fields}\nSIZE {size}\nTYPE {typ}\nCOUNT {count}\n"
+                    f"WIDTH 3\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 3\nDATA {encoding}\n").encode()
+        cases = {
+            "ascii": header("x y z", "4 4 4", "F F F", "1 1 1", "ascii") +
+            b"".join(b"%r %r %r\n" % p for p in pts),
+            "binary": header("x y z", "4 4 4", "F F F", "1 1 1", "binary") + expect,
+            # intensity before x, a uint8 label after z: picked out per point
+            "interleaved": header("intensity x y z label", "4 4 4 4 1", "F F F F U", "1 1 1 1 1", "binary") +
+            b"".join(struct.pack("<f3fB", 9.0, *p, 7) for p in pts),
+        }
+        for name, data in cases.items():
+            path = os.path.join(self.root, name + ".pcd")
+            with open(path, "wb") as f:
+                f.write(data)
+            xyz, w, h = sc.read_pcd(path)
+            self.assertEqual((w, h), (3, 1), name)
+            got = struct.unpack("<9f", xyz)
+            want = struct.unpack("<9f", expect)
+            for a, b in zip(got, want):
+                self.assertTrue(a == b or (math.isnan(a) and math.isnan(b)), f"{name}: {got} != {want}")
+        with open(os.path.join(self.root, "short.pcd"), "wb") as f:
+            f.write(cases["binary"][:-5])
+        with self.assertRaisesRegex(sc.ClientError, "truncated"):
+            sc.read_pcd(os.path.join(self.root, "short.pcd"))
+        with open(os.path.join(self.root, "huge.pcd"), "wb") as f:
+            f.write(header("x y z", "4 4 4", "F F F", "1 1 1", "binary").replace(b"WIDTH 3", b"WIDTH 4000000000"))
+        with self.assertRaisesRegex(sc.ClientError, "bad PCD sizes"):
+            sc.read_pcd(os.path.join(self.root, "huge.pcd"))
+
+    def test_stl_reader_merges_identical_vertices_in_ascii_and_binary(self):
+        import surfinspect_client as sc
+        # Two triangles sharing the edge (1,0,0)-(0,1,0): 4 vertices, not 6.
+        tris = [((0, 0, 0), (1, 0, 0), (0, 1, 0)), ((1, 0, 0), (1, 1, 0), (0, 1, 0))]
+        binary = b"\0" * 80 + struct.pack("<I", 2) + b"".join(
+            struct.pack("<3f", 0, 0, 1) + b"".join(struct.pack("<3f", *v) for v in t) + b"\0\0" for t in tris)
+        ascii_stl = "solid t\n" + "".join(
+            "facet normal 0 0 1\nouter loop\n" + "".join(f"vertex {x} {y} {z}\n" for x, y, z in t) +
+            "endloop\nendfacet\n" for t in tris) + "endsolid t\n"
+        results = []
+        for name, data in (("b.stl", binary), ("a.stl", ascii_stl.encode())):
+            path = os.path.join(self.root, name)
+            with open(path, "wb") as f:
+                f.write(data)
+            results.append(sc.read_stl(path))
+        self.assertEqual(results[0], results[1])
+        vertices, triangles = results[0]
+        self.assertEqual(len(vertices), 4 * 12)
+        self.assertEqual(struct.unpack("<6I", triangles), (0, 1, 2, 1, 3, 2))
+        with open(os.path.join(self.root, "junk.stl"), "wb") as f:
+            f.write(b"\x01" * 90)
+        with self.assertRaisesRegex(sc.ClientError, "not an STL"):
+            sc.read_stl(os.path.join(self.root, "junk.stl"))
+
+
+if __name__ == "__main__":
+    BIN = os.path.abspath(sys.argv[1])
+    SRC = os.path.abspath(sys.argv[2])
+    unittest.main(argv=[sys.argv[0]] + sys.argv[3:], verbosity=2)
