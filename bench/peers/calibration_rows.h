@@ -191,7 +191,7 @@ inline void AddCalibrationRows(std::vector<Row>& rows) {
     const std::string start = PoseError(truth, c.init_gauge_from_sensor);
     CalibrationResult ours;
     bool ok = true;
-    const double t_ours = MedianSeconds(3, false, [&] {
+    const double t_ours = MedianSeconds(3, true, [&] {
       auto index = MeshIndex::Build(cell.gauge);
       auto r = index.ok() ? CalibrateViewpoint(**index, vp.world_from_gauge, cloud,
                                                vp.world_from_gauge * c.init_gauge_from_sensor, {})

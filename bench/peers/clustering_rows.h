@@ -148,17 +148,22 @@ inline void AddClusteringRows(std::vector<Row>& rows) {
 
   const double faster_pcl = std::min(pcl_org, pcl_ece_scan);
   const double ratio_scan = faster_pcl / ours8;
+  // Two goals from issue 4 on this row: the absolute time and the ratio to
+  // the faster of the two PCL methods (measured here, not assumed).
+  const bool fast = ours8 <= 5e-3, far_ahead = ratio_scan >= 20;
   rows.push_back({"Link clustering, 1024x768 organized scan (ours: grid, 8-nb, 1 core)", Time(ours8),
-                  Time(pcl_org) + " (PCL OrganizedConnectedComponentSegmentation)",
+                  Time(pcl_org) + " (PCL OrganizedConnectedComponentSegmentation, 4-nb)",
                   Fmt("%.1fx", pcl_org / ours8),
                   "ours 4-nb (" + Time(ours4) + ") vs PCL: " +
                       AgreementText(diff_org, r4.valid_points),
-                  "≤ 5 ms on one core", Verdict(ours8 <= 5e-3)});
-  rows.push_back({"Link clustering, same scan's points vs PCL EuclideanClusterExtraction",
-                  Time(ours8), Time(pcl_ece_scan) + " (PCL ECE, kd-tree build included)",
+                  "≤ 5 ms on one core; ≥ 20x the faster PCL method",
+                  Verdict(fast) + " (" + Time(ours8) + "); " + Verdict(far_ahead) +
+                      Fmt(" (%.1fx)", ratio_scan)});
+  rows.push_back({"Link clustering, the same scan's valid points, unorganized", Time(ours8) + " (grid path)",
+                  Time(pcl_ece_scan) + " (PCL EuclideanClusterExtraction, kd-tree build included)",
                   Fmt("%.1fx", pcl_ece_scan / ours8),
                   "our voxel path vs ECE: " + AgreementText(diff_ece_scan, ru_scan.valid_points),
-                  "≥ 20x the faster PCL method", Verdict(ratio_scan >= 20) + Fmt(" (%.1fx)", ratio_scan)});
+                  "(the slower PCL method; see the row above)", "—"});
 
   // 10^6 unorganized points: our voxel path vs PCL ECE.
   LinkClusteringResult ru;
