@@ -118,7 +118,6 @@ inline void AddClusteringRows(std::vector<Row>& rows) {
   LinkClusteringResult r8, r4;
   LinkClusteringSettings s4 = settings;
   s4.connectivity = 4;
-  const double ours8 = MedianSeconds(31, true, [&] { (void)ClusterLinksOrganized(scan, settings, r8); });
   const double ours4 = MedianSeconds(31, true, [&] { (void)ClusterLinksOrganized(scan, s4, r4); });
 
   // PCL organized: 4-neighbours, links when |p - q| < 0.5 mm.
@@ -128,11 +127,13 @@ inline void AddClusteringRows(std::vector<Row>& rows) {
   pcl::OrganizedConnectedComponentSegmentation<pcl::PointXYZ, pcl::Label> seg(comparator);
   seg.setInputCloud(pcl_scan);
   pcl::PointCloud<pcl::Label> pcl_labels;
-  const double pcl_org = MedianSeconds(9, true, [&] {
-    pcl_labels.clear();
-    std::vector<pcl::PointIndices> indices;
-    seg.segment(pcl_labels, indices);
-  });
+  const auto [ours8, pcl_org] = MedianSecondsInterleaved(
+      21, true, [&] { (void)ClusterLinksOrganized(scan, settings, r8); },
+      [&] {
+        pcl_labels.clear();
+        std::vector<pcl::PointIndices> indices;
+        seg.segment(pcl_labels, indices);
+      });
   std::vector<int64_t> peer(scan.size());
   for (std::size_t i = 0; i < scan.size(); ++i) peer[i] = int64_t(pcl_labels[i].label);
   const std::size_t diff_org = PartitionDifferences(r4.labels, peer);
@@ -167,9 +168,11 @@ inline void AddClusteringRows(std::vector<Row>& rows) {
 
   // 10^6 unorganized points: our voxel path vs PCL ECE.
   LinkClusteringResult ru;
-  const double ours_u = MedianSeconds(5, true, [&] { (void)ClusterLinksUnorganized(million, settings, ru); });
   std::vector<int64_t> ece;
-  const double pcl_ece = MedianSeconds(3, false, [&] { ece = EceLabels(pcl_million, settings.link_distance_mm); });
+  (void)ClusterLinksUnorganized(million, settings, ru);  // warm-up
+  const auto [ours_u, pcl_ece] = MedianSecondsInterleaved(
+      3, false, [&] { (void)ClusterLinksUnorganized(million, settings, ru); },
+      [&] { ece = EceLabels(pcl_million, settings.link_distance_mm); });
   const double ratio_u = pcl_ece / ours_u;
   rows.push_back({"Link clustering, 10^6 unorganized points (ours: voxel path, 1 core)", Time(ours_u),
                   Time(pcl_ece) + " (PCL ECE, kd-tree build included)", Fmt("%.1fx", ratio_u),

@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <random>
+#include <tuple>
 
 #include "bench/peers/report.h"
 #include "core/mesh_index.h"
@@ -134,14 +135,20 @@ inline void AddDistanceRows(std::vector<Row>& rows, std::vector<ScalingRow>& sca
   for (const auto* which : {&random_order, &scan_order}) {
     const bool scan = which == &scan_order;
     std::vector<float> ours, peer;
-    const double t_ours = MedianSeconds(3, true, [&] { OurDistances(**index, *which, ours); });
+    double t_ours = 0;
+#ifdef SURFINSPECT_HAVE_OPEN3D
+    const o3c::Tensor q = Open3dScene::Points(*which);
+    double t_peer = 0;
+    std::tie(t_ours, t_peer) = MedianSecondsInterleaved(
+        3, true, [&] { OurDistances(**index, *which, ours); }, [&] { o3d.Distances(q, peer); });
+#else
+    t_ours = MedianSeconds(3, true, [&] { OurDistances(**index, *which, ours); });
+#endif
     Row row{std::string("Closest-point distances, 10^6 near-surface points, 150k triangles, ") +
                 (scan ? "scan order" : "random order") + " (2 threads)",
             Time(t_ours) + Fmt(" (%.2f M pts/s)", 1e-6 * which->size() / t_ours), kNoOpen3d, "—",
             "—", "≥ 5x Open3D throughput", "—"};
 #ifdef SURFINSPECT_HAVE_OPEN3D
-    const o3c::Tensor q = Open3dScene::Points(*which);
-    const double t_peer = MedianSeconds(3, false, [&] { o3d.Distances(q, peer); });
     row.peer = Time(t_peer) + " (Open3D ComputeDistance)";
     row.ratio = Fmt("%.1fx", t_peer / t_ours);
     row.agreement = Fmt("max |ours - Open3D| = %.2g mm", MaxAbsDiff(ours, peer));
@@ -155,12 +162,18 @@ inline void AddDistanceRows(std::vector<Row>& rows, std::vector<ScalingRow>& sca
     const PointCloud pts = RandomPoints(n, 11);
     const int reps = n >= 10'000'000 ? 1 : 3;
     std::vector<float> ours, peer;
-    const double t_ours = MedianSeconds(reps, false, [&] { OurDistances(**index, pts, ours); });
-    ScalingRow row{Fmt("distances, %.0e points, 150k triangles", double(n)),
-                   Time(t_ours) + Fmt(" (%.0f ns/pt)", 1e9 * t_ours / n), kNoOpen3d, ""};
+    double t_ours = 0;
 #ifdef SURFINSPECT_HAVE_OPEN3D
     const o3c::Tensor q = Open3dScene::Points(pts);
-    const double t_peer = MedianSeconds(reps, false, [&] { o3d.Distances(q, peer); });
+    double t_peer = 0;
+    std::tie(t_ours, t_peer) = MedianSecondsInterleaved(
+        reps, false, [&] { OurDistances(**index, pts, ours); }, [&] { o3d.Distances(q, peer); });
+#else
+    t_ours = MedianSeconds(reps, false, [&] { OurDistances(**index, pts, ours); });
+#endif
+    ScalingRow row{Fmt("distances, 10^%.0f points (random order), 150k triangles", std::log10(double(n))),
+                   Time(t_ours) + Fmt(" (%.0f ns/pt)", 1e9 * t_ours / n), kNoOpen3d, ""};
+#ifdef SURFINSPECT_HAVE_OPEN3D
     row.peer = Time(t_peer) + Fmt(" (%.0f ns/pt)", 1e9 * t_peer / n);
     row.note = Fmt("Open3D / ours %.1fx", t_peer / t_ours) +
                Fmt(", max diff %.2g mm", MaxAbsDiff(ours, peer));
@@ -182,7 +195,7 @@ inline void AddDistanceRows(std::vector<Row>& rows, std::vector<ScalingRow>& sca
       build = (*idx)->info().build_seconds;
       return MedianSeconds(3, true, [&] { OurDistances(**idx, pts, ours); });
     }();
-    ScalingRow row{Fmt("distances, 10^5 points, %.0f triangles", double(m.num_triangles())),
+    ScalingRow row{Fmt("distances, 10^5 points, %.0f triangles (BVH build, then query)", double(m.num_triangles())),
                    "build " + Time(build) + ", query " + Time(t_query), kNoOpen3d, ""};
 #ifdef SURFINSPECT_HAVE_OPEN3D
     double t_build_peer = 0, t_peer = 0;

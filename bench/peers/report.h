@@ -10,6 +10,7 @@
 #include <fstream>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace surfinspect::bench {
@@ -27,6 +28,21 @@ double MedianSeconds(int reps, bool warm_up, F&& f) {
   }
   std::sort(t.begin(), t.end());
   return t[t.size() / 2];
+}
+
+// Medians of a() and b() timed alternately (a, b, a, b, ...), so a change in
+// the machine's load during the run hits both sides alike.
+template <class A, class B>
+std::pair<double, double> MedianSecondsInterleaved(int reps, bool warm_up, A&& a, B&& b) {
+  if (warm_up) a(), b();
+  std::vector<double> ta, tb;
+  for (int i = 0; i < reps; ++i) {
+    ta.push_back(MedianSeconds(1, false, a));
+    tb.push_back(MedianSeconds(1, false, b));
+  }
+  std::sort(ta.begin(), ta.end());
+  std::sort(tb.begin(), tb.end());
+  return {ta[ta.size() / 2], tb[tb.size() / 2]};
 }
 
 inline std::string Fmt(const char* fmt, double v) {
