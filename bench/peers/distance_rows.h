@@ -151,7 +151,7 @@ inline void AddDistanceRows(std::vector<Row>& rows, std::vector<ScalingRow>& sca
 #ifdef SURFINSPECT_HAVE_OPEN3D
     row.peer = Time(t_peer) + " (Open3D ComputeDistance)";
     row.ratio = Fmt("%.1fx", t_peer / t_ours);
-    row.agreement = Fmt("max |ours - Open3D| = %.2g mm", MaxAbsDiff(ours, peer));
+    row.agreement = Fmt("max abs(ours − Open3D) = %.2g mm", MaxAbsDiff(ours, peer));
     row.met = Verdict(t_peer / t_ours >= 5);
 #endif
     rows.push_back(row);

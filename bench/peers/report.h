@@ -46,7 +46,7 @@ std::pair<double, double> MedianSecondsInterleaved(int reps, bool warm_up, A&& a
 }
 
 inline std::string Fmt(const char* fmt, double v) {
-  char buf[64];
+  char buf[256];
   std::snprintf(buf, sizeof buf, fmt, v);
   return buf;
 }
@@ -94,7 +94,7 @@ inline std::string MarkdownTable(const std::vector<std::string>& header,
   std::string out = "|";
   for (const auto& h : header) out += " " + h + " |";
   out += "\n|";
-  for (std::size_t i = 0; i < header.size(); ++i) out += i == 0 ? "---|" : "---:|";
+  for (std::size_t i = 0; i < header.size(); ++i) out += "---|";
   out += "\n";
   for (const auto& r : rows) {
     out += "|";
