@@ -59,5 +59,14 @@ int main(int argc, char** argv) {
     return 1;
   }
   std::fprintf(stderr, "[peers_bench] wrote %s\n", path.c_str());
-  return 0;
+  // A row that could not be measured fails the run (./run bench stops).
+  int failed = 0;
+  for (const Row& r : rows)
+    for (const std::string* cell : {&r.ours, &r.peer, &r.agreement})
+      if (cell->find("failed") != std::string::npos || cell->find("missing") != std::string::npos) {
+        std::fprintf(stderr, "peers_bench: row not measured: %s\n", r.what.c_str());
+        ++failed;
+        break;
+      }
+  return failed == 0 ? 0 : 2;
 }
