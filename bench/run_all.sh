@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Runs the benchmarks: the peer comparison table (peers_bench, which writes
+# RESULTS_DIR/latest.md), then each Google Benchmark executable with short
+# minimum times, their console output kept in RESULTS_DIR/gbench-*.txt.
+# Fails loudly on the first error. Budget: < 10 minutes on 2 cores.
+#   bench/run_all.sh BIN_DIR RESULTS_DIR
+set -euo pipefail
+BIN_DIR=${1:?usage: run_all.sh BIN_DIR RESULTS_DIR}
+RESULTS_DIR=${2:?usage: run_all.sh BIN_DIR RESULTS_DIR}
+mkdir -p "$RESULTS_DIR"
+log() { printf '\033[1m[bench]\033[0m %s\n' "$*" >&2; }
+die() { printf '\033[31m[bench] error:\033[0m %s\n' "$*" >&2; exit 1; }
+
+[ -x "$BIN_DIR/peers_bench" ] || die "$BIN_DIR/peers_bench not built (SURFINSPECT_BUILD_BENCH=ON)"
+[ -x "$BIN_DIR/surfinspectd" ] || die "$BIN_DIR/surfinspectd not built (the service rows need it)"
+start=$(date +%s)
+
+log "peer comparison table -> $RESULTS_DIR/latest.md"
+"$BIN_DIR/peers_bench" "$RESULTS_DIR" || die "peers_bench failed"
+
+# The per-kernel Google Benchmarks, short: the table above is the record.
+# service_bench is skipped here: peers_bench measures the same service rows.
+if [ "${BENCH_SKIP_GBENCH:-0}" != 1 ]; then
+  for b in link_clustering_bench scan_simulator_bench; do
+    [ -x "$BIN_DIR/$b" ] || die "$BIN_DIR/$b not built"
+    log "$b"
+    tmp=$(mktemp "$RESULTS_DIR/.gbench-$b.XXXXXX")
+    "$BIN_DIR/$b" --benchmark_min_time=0.2 --benchmark_color=false >"$tmp" || { rm -f "$tmp"; die "$b failed"; }
+    mv "$tmp" "$RESULTS_DIR/gbench-$b.txt"
+  done
+fi
+log "done in $(( $(date +%s) - start )) s; table: $RESULTS_DIR/latest.md"
