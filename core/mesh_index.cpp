@@ -30,31 +30,46 @@ struct QueryState {
   Eigen::Vector3d p;
   const Eigen::Vector3f* vertices;
   const Triangle* triangles;
+  const Eigen::Vector3d* face_normals;
   double coordinate_scale;
   double best_d2;  // the squared limit until a triangle is accepted
   uint32_t best_triangle = UINT32_MAX;
   PointTriangleResult best;
+
+  // Keeps the lexicographic minimum of (squared distance, triangle id), so
+  // the answer does not depend on the order triangles are offered in.
+  bool Offer(uint32_t t) {
+    const Triangle& tri = triangles[t];
+    const Eigen::Vector3d a = vertices[tri[0]].cast<double>();
+    // The distance to the triangle's plane is a lower bound on the distance
+    // to the triangle: one dot product rejects most candidates. The slack,
+    // far above the rounding of either computation, keeps exact ties
+    // (points on shared edges and vertices) for the full test below.
+    const Eigen::Vector3d pa = p - a;
+    const double below = std::abs(pa.dot(face_normals[t])) - 1e-12 * pa.lpNorm<1>();
+    if (below > 0 && below * below > best_d2) return false;
+    const PointTriangleResult r =
+        ClosestPointOnTriangle(p, a, vertices[tri[1]].cast<double>(), vertices[tri[2]].cast<double>());
+    const bool better = best_triangle == UINT32_MAX
+                            ? r.squared_distance <= best_d2
+                            : r.squared_distance < best_d2 ||
+                                  (r.squared_distance == best_d2 && t < best_triangle);
+    if (!better) return false;
+    best = r;
+    best_d2 = r.squared_distance;
+    best_triangle = t;
+    return true;
+  }
 };
 
-// Called by Embree for every triangle whose bounds meet the query sphere.
-// Keeps the lexicographic minimum of (squared distance, triangle id) and
-// shrinks the radius; returns true when it did, as Embree asks.
+// Called by Embree for every triangle whose bounds meet the query sphere;
+// shrinks the radius after an improvement and returns true when it did, as
+// Embree asks.
+
 bool OnCandidate(RTCPointQueryFunctionArguments* args) {
   auto& s = *static_cast<QueryState*>(args->userPtr);
-  const uint32_t t = args->primID;
-  const Triangle& tri = s.triangles[t];
-  const PointTriangleResult r =
-      ClosestPointOnTriangle(s.p, s.vertices[tri[0]].cast<double>(),
-                             s.vertices[tri[1]].cast<double>(), s.vertices[tri[2]].cast<double>());
-  const bool better = s.best_triangle == UINT32_MAX
-                          ? r.squared_distance <= s.best_d2
-                          : r.squared_distance < s.best_d2 ||
-                                (r.squared_distance == s.best_d2 && t < s.best_triangle);
-  if (!better) return false;
-  s.best = r;
-  s.best_d2 = r.squared_distance;
-  s.best_triangle = t;
-  const float radius = SearchRadius(std::sqrt(r.squared_distance), s.coordinate_scale);
+  if (!s.Offer(args->primID)) return false;
+  const float radius = SearchRadius(std::sqrt(s.best_d2), s.coordinate_scale);
   if (!(radius < args->query->radius)) return false;
   args->query->radius = radius;
   return true;
@@ -197,18 +212,23 @@ const Eigen::Vector3d& MeshIndex::Pseudonormal(uint32_t triangle, ClosestFeature
   return face_normal_[triangle];
 }
 
-ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_distance_mm) const {
+ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_distance_mm,
+                               uint32_t hint_triangle) const {
   ClosestPoint out;
   if (!p_in_mesh.allFinite() || !(max_distance_mm >= 0)) return out;
-  QueryState s{p_in_mesh, mesh_.vertices.data(), mesh_.triangles.data(),
+  QueryState s{p_in_mesh, mesh_.vertices.data(), mesh_.triangles.data(), face_normal_.data(),
                p_in_mesh.cwiseAbs().maxCoeff(), max_distance_mm * max_distance_mm,
                UINT32_MAX, {}};
+  // A good first candidate (the previous point's triangle) starts the
+  // search with a nearly exact radius; the result is the same without it.
+  if (hint_triangle < mesh_.num_triangles()) s.Offer(hint_triangle);
   RTCPointQuery query;
   query.x = static_cast<float>(p_in_mesh.x());
   query.y = static_cast<float>(p_in_mesh.y());
   query.z = static_cast<float>(p_in_mesh.z());
   query.time = 0.f;
-  query.radius = SearchRadius(max_distance_mm, s.coordinate_scale);
+  query.radius = SearchRadius(s.best_triangle == UINT32_MAX ? max_distance_mm : std::sqrt(s.best_d2),
+                              s.coordinate_scale);
   // Beyond float range Embree cannot place the point; such a point is unmatched.
   if (!std::isfinite(query.x) || !std::isfinite(query.y) || !std::isfinite(query.z)) return out;
   RTCPointQueryContext context;
@@ -230,6 +250,8 @@ ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_dis
   out.signed_distance_mm = side < 0 ? -out.distance_mm : out.distance_mm;
   return out;
 }
+
+absl::Status MeshIndex::TakeDeviceError() const { return device_->TakeError(); }
 
 std::size_t MeshIndex::memory_bytes() const {
   const int64_t embree = embree_bytes_ ? embree_bytes_->load(std::memory_order_relaxed) : 0;

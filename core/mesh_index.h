@@ -82,8 +82,16 @@ class MeshIndex {
 
   // The closest point on the mesh to `p_in_mesh` (mm, mesh frame) if it lies
   // within `max_distance_mm` (inclusive), otherwise unmatched. A non-finite
-  // point is unmatched. Thread-safe.
-  ClosestPoint Closest(const Eigen::Vector3d& p_in_mesh, double max_distance_mm = INFINITY) const;
+  // point is unmatched. `hint_triangle`, a triangle likely to be close (the
+  // previous scan point's), only speeds the search up: the answer is the
+  // same with any hint or none. Thread-safe.
+  ClosestPoint Closest(const Eigen::Vector3d& p_in_mesh, double max_distance_mm = INFINITY,
+                       uint32_t hint_triangle = UINT32_MAX) const;
+
+  // Embree reports failures through the device's error callback, not
+  // through rtcPointQuery: this returns (and clears) any error recorded
+  // since the last call. The batch queries check it when they finish.
+  absl::Status TakeDeviceError() const;
 
   const TriangleMesh& mesh() const { return mesh_; }
   const MeshIndexInfo& info() const { return info_; }

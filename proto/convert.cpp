@@ -91,8 +91,9 @@ void MeshToProto(const TriangleMesh& mesh, v1::InlineMesh* msg) {
 }
 
 absl::StatusOr<LinkClusteringSettings> FilterSettingsFromProto(const v1::FilterSettings& msg,
-                                                               const std::string& field) {
-  LinkClusteringSettings s;
+                                                               const std::string& field,
+                                                               const LinkClusteringSettings& base) {
+  LinkClusteringSettings s = base;
   if (msg.has_link_distance_mm()) s.link_distance_mm = msg.link_distance_mm();
   if (msg.has_min_cluster_points()) s.min_cluster_points = msg.min_cluster_points();
   if (msg.has_connectivity()) s.connectivity = static_cast<int>(msg.connectivity());
@@ -115,6 +116,9 @@ void FilterStatsToProto(const LinkClusteringResult& r, v1::FilterStats* msg) {
   msg->set_removed(r.removed);
   msg->set_clusters(r.clusters.size());
   msg->set_largest_cluster(r.largest_cluster);
+  uint64_t removed_clusters = 0;
+  for (const ClusterInfo& k : r.clusters) removed_clusters += k.kept ? 0 : 1;
+  msg->set_removed_clusters(removed_clusters);
 }
 
 absl::StatusOr<IcpSettings> IcpSettingsFromProto(const v1::IcpSettings& msg, const std::string& field) {

@@ -47,8 +47,10 @@ absl::StatusOr<TriangleMesh> MeshFromProto(const v1::InlineMesh& msg, const std:
 void MeshToProto(const TriangleMesh& mesh, v1::InlineMesh* msg);
 
 // ---- settings and results ----
-absl::StatusOr<LinkClusteringSettings> FilterSettingsFromProto(const v1::FilterSettings& msg,
-                                                               const std::string& field);
+// Unset fields keep `base` (the paper's defaults unless told otherwise).
+absl::StatusOr<LinkClusteringSettings> FilterSettingsFromProto(
+    const v1::FilterSettings& msg, const std::string& field,
+    const LinkClusteringSettings& base = LinkClusteringSettings{});
 void FilterSettingsToProto(const LinkClusteringSettings& s, v1::FilterSettings* msg);
 void FilterStatsToProto(const LinkClusteringResult& r, v1::FilterStats* msg);
 

@@ -40,7 +40,7 @@ grpc::Status InspectReactor::Consume(const v1::InspectRequest& msg) {
         return ToGrpc(t.status());
       if (auto s = wire::ErrorMapSettingsFromProto(header_.error_map(), "part.error_map"); !s.ok())
         return ToGrpc(s.status());
-      if (auto f = wire::FilterSettingsFromProto(header_.filter(), "part.filter"); !f.ok())
+      if (auto f = wire::FilterSettingsFromProto(header_.filter(), "part.filter", LinkClusteringSettings::ForInspection()); !f.ok())
         return ToGrpc(f.status());
       state_ = State::kExpectView;
       return grpc::Status::OK;
@@ -144,7 +144,7 @@ void InspectReactor::Compute() {
     if (st.ok()) {
       InspectionSettings settings;
       settings.filter = !header_.skip_filter();
-      settings.filter_settings = *wire::FilterSettingsFromProto(header_.filter(), "part.filter");
+      settings.filter_settings = *wire::FilterSettingsFromProto(header_.filter(), "part.filter", LinkClusteringSettings::ForInspection());
       settings.error_map = *wire::ErrorMapSettingsFromProto(header_.error_map(), "part.error_map");
       const Eigen::Isometry3d world_from_part =
           *wire::TransformFromProto(header_.world_from_part(), "part.world_from_part");

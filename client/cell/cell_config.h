@@ -44,7 +44,7 @@ struct CellConfig {
   std::vector<CellViewpoint> viewpoints;
   ErrorMapSettings error_map;
   bool filter = true;
-  LinkClusteringSettings filter_settings;
+  LinkClusteringSettings filter_settings = LinkClusteringSettings::ForInspection();
   CellServer server;
   nlohmann::json raw;               // the whole file, kept for rewriting
 };

@@ -8,6 +8,8 @@
 #include <nlohmann/json.hpp>
 
 #include "client/cli/commands.h"
+#include "client/cli/remote_args.h"
+#include "proto/convert.h"
 #include "core/atomic_file.h"
 #include "core/error_map.h"
 #include "core/error_map_output.h"
@@ -26,10 +28,15 @@ struct ErrorMapArgs {
   std::string frame = "part";
   std::string png_axis = "auto";
   ErrorMapSettings settings;
+  RemoteArgs remote;
 };
 
 double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+double Number(const nlohmann::json& j, const char* key) {
+  return j.contains(key) && j[key].is_number() ? j[key].get<double>() : NAN;
 }
 
 void RunErrorMap(const ErrorMapArgs& a) {
@@ -41,44 +48,69 @@ void RunErrorMap(const ErrorMapArgs& a) {
   auto mesh = Take(ReadMesh(a.mesh));
   spdlog::info("read {} points and {} triangles in {:.3f} s", cloud_in_world.size(),
                mesh.num_triangles(), Seconds(t0));
-  t0 = std::chrono::steady_clock::now();
-  const std::unique_ptr<MeshIndex> index = Take(MeshIndex::Build(std::move(mesh)));
-  const MeshIndexInfo& info = index->info();
-  spdlog::info("mesh index built in {:.3f} s ({} boundary edges, {} degenerate triangles)",
-               info.build_seconds, info.boundary_edges, info.degenerate_triangles);
-
-  const ErrorMapResult r = Take(ComputeErrorMap(*index, cloud_in_world, world_from_part, a.settings));
-  spdlog::info("distances for {} points in {:.3f} s", r.stats.count, r.query_seconds);
-
-  // Files carry part-frame coordinates by default, so they overlay the CAD.
+  const MeshTopology topo = AnalyzeTopology(mesh);
+  const nlohmann::json mesh_json = {{"triangles", mesh.num_triangles()},
+                                    {"boundary_edges", topo.boundary_edges},
+                                    {"nonmanifold_edges", topo.nonmanifold_edges},
+                                    {"degenerate_triangles", mesh.CountDegenerate()}};
   const PointCloud cloud_in_part = TransformCloud(cloud_in_world, world_from_part.inverse());
+  ErrorMapResult r;
+  nlohmann::json j;
+  std::string png_bytes;
+  if (a.remote.remote()) {
+    // The server computes; PLY/CSV are written here from its deviations, the
+    // report and PNG are its bytes (so both paths write the same files,
+    // timing aside).
+    if (a.settings.split_components) throw CommandFailed("--split-components is in-process only");
+    if (!a.png.empty() && a.png_axis != "auto") throw CommandFailed("--png-axis is in-process only");
+    v1::ErrorMapRequest req;
+    wire::CloudToProto(cloud_in_world, req.mutable_cloud());
+    wire::TransformToProto(world_from_part, req.mutable_world_from_part());
+    wire::ErrorMapSettingsToProto(a.settings, req.mutable_settings());
+    req.set_return_deviations(true);
+    req.set_return_png(!a.png.empty());
+    const v1::ErrorMapResponse resp = Take(Connect(a.remote)->ErrorMap(req, mesh));
+    r.deviation_mm = wire::UnpackFloats(resp.deviations());
+    if (r.deviation_mm.size() != cloud_in_world.size()) throw CommandFailed("server sent a wrong deviation count");
+    j = nlohmann::json::parse(resp.report_json(), nullptr, false);
+    if (j.is_discarded()) throw CommandFailed("server sent a malformed report");
+    r.tolerance_mm = Number(j["tolerance"], "band_mm");
+    r.color_range_mm = Number(j, "color_range_mm");
+    png_bytes = resp.png();
+  } else {
+    const std::unique_ptr<MeshIndex> index = Take(MeshIndex::Build(std::move(mesh)));
+    spdlog::info("mesh index built in {:.3f} s ({} boundary edges, {} degenerate triangles)",
+                 index->info().build_seconds, topo.boundary_edges, index->info().degenerate_triangles);
+    r = Take(ComputeErrorMap(*index, cloud_in_world, world_from_part, a.settings));
+    spdlog::info("distances for {} points in {:.3f} s", r.stats.count, r.query_seconds);
+    j = ErrorMapReportJson(r, a.settings);
+    if (!a.png.empty()) {
+      ErrorMapPngOptions png;
+      png.view_axis = a.png_axis == "x" ? 0 : a.png_axis == "y" ? 1 : a.png_axis == "z" ? 2 : -1;
+      png_bytes = Take(EncodePng(Take(RenderErrorMap(cloud_in_part, r, ComputeBounds(index->mesh()), png))));
+    }
+  }
+  // Files carry part-frame coordinates by default, so they overlay the CAD.
   const PointCloud& written = a.frame == "world" ? cloud_in_world : cloud_in_part;
   Check(WriteErrorMapPly(a.out, written, r, a.frame));
   if (!a.csv.empty()) Check(WriteErrorMapCsv(a.csv, written, r));
-  if (!a.png.empty()) {
-    ErrorMapPngOptions png;
-    png.view_axis = a.png_axis == "x" ? 0 : a.png_axis == "y" ? 1 : a.png_axis == "z" ? 2 : -1;
-    Check(WriteErrorMapPng(a.png, cloud_in_part, r, ComputeBounds(index->mesh()), png));
-  }
+  if (!a.png.empty()) Check(WriteStringAtomically(a.png, png_bytes));
   if (!a.report.empty()) {
-    nlohmann::json j = ErrorMapReportJson(r, a.settings);
     j["inputs"] = {{"cloud", a.cloud}, {"mesh", a.mesh}, {"world_from_part", a.world_from_part}};
-    j["mesh"] = {{"triangles", info.triangles},
-                 {"boundary_edges", info.boundary_edges},
-                 {"nonmanifold_edges", info.nonmanifold_edges},
-                 {"degenerate_triangles", info.degenerate_triangles}};
+    j["mesh"] = mesh_json;
     j["output_frame"] = a.frame;
     Check(WriteStringAtomically(a.report, j.dump(2) + "\n"));
   }
-
-  const ErrorMapStats& s = r.stats;
-  std::printf("points: %zu (valid %zu, matched %zu within %g mm)\n", s.count, s.valid, s.matched,
+  const nlohmann::json& st = j["statistics"];
+  const nlohmann::json& pts = j["points"];
+  std::printf("points: %zu (valid %zu, matched %zu within %g mm)\n", pts.value("count", std::size_t{0}),
+              pts.value("valid", std::size_t{0}), pts.value("matched", std::size_t{0}),
               a.settings.max_distance_mm);
-  std::printf("deviation mm: min %.4f  max %.4f  mean %.4f  std %.4f  rms %.4f\n", s.min_mm,
-              s.max_mm, s.mean_mm, s.stddev_mm, s.rms_mm);
-  std::printf("percentiles mm: p1 %.4f  p5 %.4f  p50 %.4f  p95 %.4f  p99 %.4f\n", s.p1_mm, s.p5_mm,
-              s.p50_mm, s.p95_mm, s.p99_mm);
-  std::printf("verdict: %s\n", r.verdict.reason.c_str());
+  std::printf("deviation mm: min %.4f  max %.4f  mean %.4f  std %.4f  rms %.4f\n", Number(st, "min_mm"),
+              Number(st, "max_mm"), Number(st, "mean_mm"), Number(st, "stddev_mm"), Number(st, "rms_mm"));
+  std::printf("percentiles mm: p1 %.4f  p5 %.4f  p50 %.4f  p95 %.4f  p99 %.4f\n", Number(st, "p1_mm"),
+              Number(st, "p5_mm"), Number(st, "p50_mm"), Number(st, "p95_mm"), Number(st, "p99_mm"));
+  std::printf("verdict: %s\n", j["tolerance"].value("reason", std::string("?")).c_str());
   std::printf("wrote %s%s%s%s%s%s%s\n", a.out.c_str(), a.csv.empty() ? "" : ", ", a.csv.c_str(),
               a.report.empty() ? "" : ", ", a.report.c_str(), a.png.empty() ? "" : ", ", a.png.c_str());
 }
@@ -112,6 +144,7 @@ void AddErrorMapCommand(CLI::App& app) {
       ->check(CLI::IsMember({"part", "world"}))->default_val("part");
   cmd->add_option("--png-axis", a->png_axis, "view axis for merged clouds (auto = CAD's thinnest)")
       ->check(CLI::IsMember({"auto", "x", "y", "z"}))->default_val("auto");
+  AddRemoteOptions(cmd, a->remote);
   cmd->callback([a] { RunErrorMap(*a); });
 }
 

@@ -8,6 +8,8 @@
 #include <nlohmann/json.hpp>
 
 #include "client/cli/commands.h"
+#include "client/cli/remote_args.h"
+#include "proto/convert.h"
 #include "core/atomic_file.h"
 #include "core/io_point_cloud.h"
 #include "core/link_clustering.h"
@@ -19,6 +21,7 @@ namespace {
 struct FilterArgs {
   std::string in, out, report, png;
   LinkClusteringSettings settings;
+  RemoteArgs remote;
 };
 
 // Kept points in grey by depth (near = bright), removed points red, no data
@@ -55,28 +58,46 @@ void Filter(const FilterArgs& a) {
   if (!a.png.empty() && !cloud.organized())
     throw CommandFailed(a.in + ": --png needs an organized cloud (there is no grid to draw)");
   const auto t0 = std::chrono::steady_clock::now();
-  const LinkClusteringResult result = Take(ClusterLinks(cloud, a.settings));
+  // Both paths end in a FilterResponse, so they write the same files.
+  v1::FilterResponse resp;
+  if (a.remote.remote()) {
+    v1::FilterRequest req;
+    wire::CloudToProto(cloud, req.mutable_cloud());
+    wire::FilterSettingsToProto(a.settings, req.mutable_settings());
+    resp = Take(Connect(a.remote)->Filter(req));
+  } else {
+    const LinkClusteringResult r = Take(ClusterLinks(cloud, a.settings));
+    wire::CloudToProto(Take(ApplyFilter(cloud, r)), resp.mutable_cloud());
+    wire::FilterStatsToProto(r, resp.mutable_stats());
+    resp.mutable_kept_mask()->assign(r.kept_mask.begin(), r.kept_mask.end());
+  }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  Check(WritePointCloud(a.out, Take(ApplyFilter(cloud, result))));
+  const v1::FilterStats& stats = resp.stats();
+  Check(WritePointCloud(a.out, Take(wire::CloudFromProto(resp.cloud(), "cloud", wire::Limits{}))));
   spdlog::info("{}: {} valid points, kept {}, removed {} in {} clusters ({:.2f} ms)", a.in,
-               result.valid_points, result.kept, result.removed, result.clusters.size(),
-               seconds * 1e3);
+               stats.valid_points(), stats.kept(), stats.removed(), stats.clusters(), seconds * 1e3);
+  // What the picture needs: which pixels had data and which were kept.
+  LinkClusteringResult result;
+  result.kept = stats.kept();
+  result.removed = stats.removed();
+  result.kept_mask.assign(resp.kept_mask().begin(), resp.kept_mask().end());
+  result.labels.resize(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    result.labels[i] = PointCloud::IsValid(cloud.points[i]) ? 0 : LinkClusteringResult::kInvalid;
   if (!a.report.empty()) {
-    std::size_t removed_clusters = 0;
-    for (const ClusterInfo& k : result.clusters) removed_clusters += k.kept ? 0 : 1;
     nlohmann::json j = {
         {"input", a.in},
         {"output", a.out},
         {"organized", cloud.organized()},
         {"width", cloud.width},
         {"height", cloud.height},
-        {"input_points", result.input_points},
-        {"valid_points", result.valid_points},
-        {"kept", result.kept},
-        {"removed", result.removed},
-        {"clusters", result.clusters.size()},
-        {"removed_clusters", removed_clusters},
-        {"largest_cluster", result.largest_cluster},
+        {"input_points", stats.input_points()},
+        {"valid_points", stats.valid_points()},
+        {"kept", stats.kept()},
+        {"removed", stats.removed()},
+        {"clusters", stats.clusters()},
+        {"removed_clusters", stats.removed_clusters()},
+        {"largest_cluster", stats.largest_cluster()},
         {"seconds", seconds},
         {"parameters",
          {{"link_distance_mm", a.settings.link_distance_mm},
@@ -112,6 +133,7 @@ void AddFilterCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--report", a->report, "JSON report of counts, timing and parameters");
   cmd->add_option("--png", a->png, "picture: kept by depth, removed red, no data black");
+  AddRemoteOptions(cmd, a->remote);
   cmd->callback([a] {
     // Bad parameters are refused before any file is read.
     Check(ValidateLinkClusteringSettings(a->settings));

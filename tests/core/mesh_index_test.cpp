@@ -94,6 +94,13 @@ void ExpectMatchesBruteForce(const TriangleMesh& m, const std::vector<Vector3d>&
     // Independent kernel: within 1e-9 relative (1e-9 mm floor on the surface).
     EXPECT_NEAR(got.distance_mm, want.independent, 1e-9 * std::max(1.0, want.independent));
     EXPECT_EQ(std::abs(got.signed_distance_mm), got.distance_mm);
+    // A hint (any triangle, near or far) never changes the answer.
+    for (uint32_t hint : {want.triangle, static_cast<uint32_t>(m.num_triangles() / 2), 0u}) {
+      const ClosestPoint hinted = index->Closest(p, INFINITY, hint);
+      EXPECT_EQ(hinted.triangle_id, got.triangle_id);
+      EXPECT_EQ(hinted.distance_mm, got.distance_mm);
+      EXPECT_EQ(hinted.signed_distance_mm, got.signed_distance_mm);
+    }
   }
 }
 

@@ -1,0 +1,89 @@
+#!/usr/bin/env python3
+"""Every CLI step run in-process and with --server writes the same files:
+byte for byte, except the wall-clock fields of the JSON reports (issue 7).
+
+usage: remote_outputs_test.py BIN_DIR
+"""
+import filecmp
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+BIN = os.path.abspath(sys.argv[1])
+TIMING_KEYS = {"seconds", "timing"}
+
+
+def run(*args, cwd):
+    subprocess.run([os.path.join(BIN, args[0]), *args[1:]], cwd=cwd, check=True,
+                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+
+def same_json(a, b):
+    # The two runs write into local/ and remote/; paths in reports differ by that.
+    with open(a) as fa, open(b) as fb:
+        ja = json.loads(fa.read().replace("local/", "OUT/"))
+        jb = json.loads(fb.read().replace("remote/", "OUT/"))
+    for j in (ja, jb):
+        for k in TIMING_KEYS:
+            j.pop(k, None)
+    return ja == jb
+
+
+def main():
+    work = tempfile.mkdtemp(prefix="remote-outputs-")
+    server = None
+    try:
+        run("surfinspect", "demo-cell", "--out", "cell", "--parts", "1", cwd=work)
+        with open(os.path.join(work, "cell", "cell.json")) as f:
+            cell = json.load(f)
+        v1 = cell["viewpoints"][0]
+        for name, key in (("wfg.json", "world_from_gauge"), ("nominal.json", "nominal_world_from_sensor"),
+                          ("truth.json", "simulation_truth_world_from_sensor")):
+            with open(os.path.join(work, name), "w") as f:
+                json.dump(v1[key], f)
+        with open(os.path.join(work, "wfp.json"), "w") as f:
+            json.dump(cell["part"]["world_from_part"], f)
+        server = subprocess.Popen([os.path.join(BIN, "surfinspectd"), "--listen", "127.0.0.1:0"],
+                                  stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+        target = server.stdout.readline().strip().rsplit(" ", 1)[-1]
+        scan = "cell/scans/part-001/v1.pcd"
+        steps = {
+            "filter": (["surfinspect", "filter", "--in", scan, "--out", "{d}/f.pcd", "--report", "{d}/f.json",
+                        "--png", "{d}/f.png"], ["f.pcd", "f.png"], ["f.json"]),
+            "calibrate": (["surfinspect", "calibrate", "--gauge", "cell/gauge.stl", "--world-from-gauge", "wfg.json",
+                           "--scan", "cell/gauge_scans/v1.pcd", "--initial-world-from-sensor", "nominal.json",
+                           "--out", "{d}/c.json", "--report", "{d}/cq.json"], ["c.json", "cq.json"], []),
+            "register": (["surfinspect", "register", "--scan", scan, "--world-from-sensor", "truth.json",
+                          "--out", "{d}/merged.ply", "--filter"], ["merged.ply"], []),
+            "errormap": (["surfinspect", "errormap", "--cloud", "{d}/merged.ply", "--mesh", "cell/part.stl",
+                          "--world-from-part", "wfp.json", "--out", "{d}/e.ply", "--csv", "{d}/e.csv",
+                          "--png", "{d}/e.png", "--report", "{d}/e.json", "--tolerance", "0.3"],
+                         ["e.ply", "e.csv", "e.png"], ["e.json"]),
+        }
+        failures = []
+        for mode in ("local", "remote"):
+            os.makedirs(os.path.join(work, mode))
+        for name, (cmd, exact, reports) in steps.items():
+            for mode in ("local", "remote"):
+                args = [a.replace("{d}", mode) for a in cmd] + (["--server", target] if mode == "remote" else [])
+                run(*args, cwd=work)
+            for f in exact:
+                if not filecmp.cmp(os.path.join(work, "local", f), os.path.join(work, "remote", f), shallow=False):
+                    failures.append(f"{name}: {f} differs")
+            for f in reports:
+                if not same_json(os.path.join(work, "local", f), os.path.join(work, "remote", f)):
+                    failures.append(f"{name}: {f} differs beyond timing")
+        print("\n".join(failures) or f"{len(steps)} steps: identical outputs in-process and via {target}")
+        return 1 if failures else 0
+    finally:
+        if server:
+            server.terminate()
+            server.wait()
+        shutil.rmtree(work, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
