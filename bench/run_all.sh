@@ -19,7 +19,7 @@ log "peer comparison table -> $RESULTS_DIR/latest.md"
 "$BIN_DIR/peers_bench" "$RESULTS_DIR" || die "peers_bench failed"
 
 # The per-kernel Google Benchmarks, short: the table above is the record.
-# service_bench is skipped here: peers_bench measures the same service rows.
+# The service rows (ErrorMap over loopback, streaming) live in peers_bench.
 if [ "${BENCH_SKIP_GBENCH:-0}" != 1 ]; then
   for b in link_clustering_bench scan_simulator_bench; do
     [ -x "$BIN_DIR/$b" ] || die "$BIN_DIR/$b not built"
