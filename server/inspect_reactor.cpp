@@ -245,7 +245,7 @@ void InspectReactor::MaybeFinishLocked() {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   service_->LogCall(request_id_, "Inspect", ctx_->peer(), total_points_, final_status_, seconds);
-  service_->metrics()->RecordRpc("Inspect", final_status_.ok() ? "OK" : std::to_string(final_status_.error_code()), seconds);
+  service_->metrics()->RecordRpc("Inspect", CodeName(final_status_.error_code()), seconds);
   if (final_status_.ok()) service_->metrics()->AddPoints(total_points_);
   if (admitted_) service_->metrics()->CallEnded();
   Finish(final_status_);

@@ -10,6 +10,9 @@ namespace surfinspect::server {
 
 grpc::Status ToGrpc(const absl::Status& status);
 
+// The code's name ("OK", "INVALID_ARGUMENT", ...) for logs and metrics.
+const char* CodeName(grpc::StatusCode code);
+
 // For validation failures that name a request field.
 grpc::Status InvalidField(const std::string& field, const std::string& why);
 
