@@ -10,6 +10,7 @@
 #include "core/atomic_file.h"
 #include "core/io_mesh.h"
 #include "core/io_point_cloud.h"
+#include "core/io_transform.h"
 #include "core/transform.h"
 
 namespace surfinspect {
@@ -105,12 +106,6 @@ double RidgeZ(double x, double length) {
   return kHeight - kBowSagMm * u * u;
 }
 
-nlohmann::json MatrixJson(const Eigen::Isometry3d& t) {
-  const RowMajor16 v = ToRowMajor(t);
-  nlohmann::json rows = nlohmann::json::array();
-  for (int r = 0; r < 4; ++r) rows.push_back({v[r * 4], v[r * 4 + 1], v[r * 4 + 2], v[r * 4 + 3]});
-  return {{"matrix", rows}};
-}
 
 }  // namespace
 
@@ -203,10 +198,10 @@ absl::Status WriteDemoCell(const std::string& dir, const DemoCell& cell,
     const std::string gauge_path = absl::StrCat("gauge_scans/", vp.name, ".pcd");
     if (auto st = WritePointCloud(dir + "/" + gauge_path, gauge_scan->cloud_in_sensor); !st.ok()) return st;
     views.push_back({{"name", vp.name},
-                     {"nominal_world_from_sensor", MatrixJson(vp.nominal_world_from_sensor)},
-                     {"world_from_gauge", MatrixJson(vp.world_from_gauge)},
+                     {"nominal_world_from_sensor", TransformToJsonValue(vp.nominal_world_from_sensor)},
+                     {"world_from_gauge", TransformToJsonValue(vp.world_from_gauge)},
                      {"gauge_scan", gauge_path},
-                     {"simulation_truth_world_from_sensor", MatrixJson(vp.world_from_sensor)}});
+                     {"simulation_truth_world_from_sensor", TransformToJsonValue(vp.world_from_sensor)}});
   }
 
   std::mt19937_64 rng(options.scan.seed + 7);
@@ -262,7 +257,7 @@ absl::Status WriteDemoCell(const std::string& dir, const DemoCell& cell,
 
   const nlohmann::json cell_json = {
       {"units", "mm"},
-      {"part", {{"mesh", "part.stl"}, {"world_from_part", MatrixJson(cell.world_from_part)}}},
+      {"part", {{"mesh", "part.stl"}, {"world_from_part", TransformToJsonValue(cell.world_from_part)}}},
       {"gauge", {{"mesh", "gauge.stl"}}},
       {"sensor",
        {{"width", cell.intrinsics.width},

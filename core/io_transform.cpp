@@ -12,6 +12,11 @@ absl::StatusOr<Eigen::Isometry3d> ParseTransformJson(const std::string& text,
                                                      const std::string& what) {
   const nlohmann::json j = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (j.is_discarded()) return absl::InvalidArgumentError(absl::StrCat(what, ": not valid JSON"));
+  return TransformFromJsonValue(j, what);
+}
+
+absl::StatusOr<Eigen::Isometry3d> TransformFromJsonValue(const nlohmann::json& j,
+                                                         const std::string& what) {
   const nlohmann::json* m = j.is_object() && j.contains("matrix") ? &j["matrix"] : nullptr;
   if (!m || !m->is_array() || m->size() != 4)
     return absl::InvalidArgumentError(
@@ -37,12 +42,16 @@ absl::StatusOr<Eigen::Isometry3d> ReadTransformJson(const std::string& path) {
   return ParseTransformJson(*text, path);
 }
 
-std::string TransformToJson(const Eigen::Isometry3d& t) {
+nlohmann::json TransformToJsonValue(const Eigen::Isometry3d& t) {
   const RowMajor16 v = ToRowMajor(t);
   nlohmann::json rows = nlohmann::json::array();
   for (int r = 0; r < 4; ++r)
     rows.push_back({v[r * 4], v[r * 4 + 1], v[r * 4 + 2], v[r * 4 + 3]});
-  return nlohmann::json{{"matrix", rows}}.dump(2) + "\n";
+  return {{"matrix", rows}};
+}
+
+std::string TransformToJson(const Eigen::Isometry3d& t) {
+  return TransformToJsonValue(t).dump(2) + "\n";
 }
 
 absl::Status WriteTransformJson(const std::string& path, const Eigen::Isometry3d& t) {

@@ -13,6 +13,7 @@
 #include <cstring>
 
 #include "bench/peers/report.h"
+#include "bench/wavy_sheet.h"
 #include "client/remote/remote_client.h"
 #include "core/demo_cell.h"
 #include "core/error_map.h"
@@ -26,22 +27,6 @@ namespace surfinspect::bench {
 
 namespace service_detail {
 
-inline TriangleMesh WavySheet(int cells, double size_mm) {
-  TriangleMesh m;
-  for (int j = 0; j <= cells; ++j)
-    for (int i = 0; i <= cells; ++i) {
-      const double x = size_mm * (double(i) / cells - 0.5), y = size_mm * (double(j) / cells - 0.5);
-      m.vertices.emplace_back(x, y, 3.0 * std::sin(x / 20.0) * std::cos(y / 25.0));
-    }
-  const auto row = static_cast<uint32_t>(cells + 1);
-  for (uint32_t j = 0; j < uint32_t(cells); ++j)
-    for (uint32_t i = 0; i < uint32_t(cells); ++i) {
-      const uint32_t v = j * row + i;
-      m.triangles.push_back({v, v + 1, v + row});
-      m.triangles.push_back({v + 1, v + row + 1, v + row});
-    }
-  return m;
-}
 
 // Seconds from the view header to STAGE_VIEW_RECEIVED; NaN on failure.
 inline double StreamOnce(v1::InspectionService::Stub& stub, const v1::InspectRequest& part,
@@ -69,7 +54,7 @@ inline double StreamOnce(v1::InspectionService::Stub& stub, const v1::InspectReq
 }  // namespace service_detail
 
 inline void AddSimulatorRow(std::vector<Row>& rows) {
-  const TriangleMesh mesh = service_detail::WavySheet(224, 300);  // 100,352 triangles
+  const TriangleMesh mesh = WavySheet(224, 300);  // 100,352 triangles
   const Eigen::Isometry3d world_from_sensor = LookAt({10, -20, 400}, {0, 0, 0});
   ScanOptions opt;
   opt.noise_sigma_mm = 0.015;

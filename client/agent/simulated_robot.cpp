@@ -74,7 +74,7 @@ absl::StatusOr<std::vector<std::string>> SimulateParts(const CellConfig& cell, c
       Eigen::Isometry3d pose = vp.world_from_sensor.value_or(vp.nominal_world_from_sensor);
       for (const auto& jv : cell.raw["viewpoints"])
         if (jv.value("name", "") == vp.name && jv.contains("simulation_truth_world_from_sensor"))
-          if (auto t = ParseTransformJson(jv["simulation_truth_world_from_sensor"].dump(), "truth"); t.ok())
+          if (auto t = TransformFromJsonValue(jv["simulation_truth_world_from_sensor"], "truth"); t.ok())
             pose = *t;
       opt.seed = seed * 1000003 + n * 101 + v;
       auto scan = SimulateScan(*part, cell.world_from_part, pose, intrinsics, opt);

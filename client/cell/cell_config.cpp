@@ -5,7 +5,6 @@
 #include "absl/strings/str_cat.h"
 #include "core/atomic_file.h"
 #include "core/io_transform.h"
-#include "core/transform.h"
 
 namespace surfinspect::client {
 namespace {
@@ -14,9 +13,6 @@ absl::Status Bad(const std::string& path, absl::string_view why) {
   return absl::InvalidArgumentError(absl::StrCat(path, ": ", why));
 }
 
-absl::StatusOr<Eigen::Isometry3d> Transform(const nlohmann::json& j, const std::string& what) {
-  return ParseTransformJson(j.dump(), what);
-}
 
 std::string Resolve(const std::string& cell_path, const std::string& p) {
   if (p.empty() || p[0] == '/') return p;
@@ -25,12 +21,6 @@ std::string Resolve(const std::string& cell_path, const std::string& p) {
 
 }  // namespace
 
-nlohmann::json TransformJson(const Eigen::Isometry3d& t) {
-  const RowMajor16 v = ToRowMajor(t);
-  nlohmann::json rows = nlohmann::json::array();
-  for (int r = 0; r < 4; ++r) rows.push_back({v[r * 4], v[r * 4 + 1], v[r * 4 + 2], v[r * 4 + 3]});
-  return {{"matrix", rows}};
-}
 
 absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
   auto text = ReadFileToString(path, 16 << 20);
@@ -44,7 +34,7 @@ absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
     if (!j.contains("part") || !j["part"].contains("mesh") || !j["part"].contains("world_from_part"))
       return Bad(path, "needs part.mesh and part.world_from_part");
     c.part_mesh = Resolve(path, j["part"]["mesh"].get<std::string>());
-    auto wfp = Transform(j["part"]["world_from_part"], path + ": part.world_from_part");
+    auto wfp = TransformFromJsonValue(j["part"]["world_from_part"], path + ": part.world_from_part");
     if (!wfp.ok()) return wfp.status();
     c.world_from_part = *wfp;
     if (j.contains("gauge") && j["gauge"].contains("mesh"))
@@ -59,17 +49,17 @@ absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
       if (vp.name.empty() || vp.name.find('/') != std::string::npos)
         return Bad(where, "name must be non-empty and contain no '/'");
       if (v.contains("nominal_world_from_sensor")) {
-        auto t = Transform(v["nominal_world_from_sensor"], where + ".nominal_world_from_sensor");
+        auto t = TransformFromJsonValue(v["nominal_world_from_sensor"], where + ".nominal_world_from_sensor");
         if (!t.ok()) return t.status();
         vp.nominal_world_from_sensor = *t;
       }
       if (v.contains("world_from_gauge")) {
-        auto t = Transform(v["world_from_gauge"], where + ".world_from_gauge");
+        auto t = TransformFromJsonValue(v["world_from_gauge"], where + ".world_from_gauge");
         if (!t.ok()) return t.status();
         vp.world_from_gauge = *t;
       }
       if (v.contains("world_from_sensor") && !v["world_from_sensor"].is_null()) {
-        auto t = Transform(v["world_from_sensor"], where + ".world_from_sensor");
+        auto t = TransformFromJsonValue(v["world_from_sensor"], where + ".world_from_sensor");
         if (!t.ok()) return t.status();
         vp.world_from_sensor = *t;
       }
@@ -120,7 +110,7 @@ absl::Status WriteCellCalibrations(const CellConfig& cell,
   for (auto& v : j["viewpoints"]) {
     const std::string name = v["name"].get<std::string>();
     for (const auto& vp : cell.viewpoints)
-      if (vp.name == name && vp.world_from_sensor) v["world_from_sensor"] = TransformJson(*vp.world_from_sensor);
+      if (vp.name == name && vp.world_from_sensor) v["world_from_sensor"] = TransformToJsonValue(*vp.world_from_sensor);
     for (const auto& [n, q] : quality)
       if (n == name) v["calibration"] = q;
   }

@@ -60,6 +60,4 @@ InspectionSettings InspectionSettingsOf(const CellConfig& cell);
 absl::Status WriteCellCalibrations(const CellConfig& cell,
                                    const std::vector<std::pair<std::string, nlohmann::json>>& quality);
 
-nlohmann::json TransformJson(const Eigen::Isometry3d& t);
-
 }  // namespace surfinspect::client
