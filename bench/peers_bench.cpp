@@ -10,6 +10,7 @@
 #include <ctime>
 #include <string>
 
+#include "core/buffer_reuse.h"
 #include "bench/peers/calibration_rows.h"
 #include "bench/peers/clustering_rows.h"
 #include "bench/peers/distance_rows.h"
@@ -18,12 +19,20 @@
 #include "core/atomic_file.h"
 
 int main(int argc, char** argv) {
+  surfinspect::ReuseFreedLargeBuffers();  // clouds are ~10 MB buffers, over and over
   using namespace surfinspect::bench;
-  const std::string results_dir = argc > 1 ? argv[1] : "bench/results";
+  // peers_bench [RESULTS_DIR] [--only SECTION]: --only runs one section
+  // (e.g. "service") and prints its rows without touching latest.md.
+  std::string results_dir = "bench/results", only;
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--only" && i + 1 < argc) only = argv[++i];
+    else results_dir = argv[i];
+  }
   const auto start = std::chrono::steady_clock::now();
   std::vector<Row> rows;
   std::vector<ScalingRow> scaling;
   auto section = [&](const char* name, auto&& fn) {
+    if (!only.empty() && only != name) return;
     std::fprintf(stderr, "[peers_bench] %s ...\n", name);
     const std::size_t before = rows.size();
     fn();
@@ -53,6 +62,7 @@ int main(int argc, char** argv) {
         "Peer / ours > 1 means we are faster.\n\n";
   md += RenderRows(rows) + "\n" + RenderScaling(scaling);
   std::fputs(md.c_str(), stdout);
+  if (!only.empty()) return 0;
   const std::string path = results_dir + "/latest.md";
   if (auto st = surfinspect::WriteStringAtomically(path, md); !st.ok()) {
     std::fprintf(stderr, "peers_bench: cannot write %s: %s\n", path.c_str(), std::string(st.message()).c_str());

@@ -40,6 +40,30 @@ absl::StatusOr<PointCloud> CloudFromBytes(const std::string& xyz, uint32_t width
   return c;
 }
 
+void CloudAssembler::Start(uint32_t width, uint32_t height) {
+  cloud_.width = width;
+  cloud_.height = height;
+  cloud_.points.resize(uint64_t{width} * height);  // Eigen's default constructor leaves them unset
+  received_ = 0;
+}
+
+absl::Status CloudAssembler::Add(const std::string& chunk, const std::string& field) {
+  if (chunk.size() > expected_bytes() - received_)
+    return Invalid(field, absl::StrCat("gets more than its ", expected_bytes(), " bytes"));
+  std::memcpy(static_cast<void*>(reinterpret_cast<char*>(cloud_.points.data()) + received_),
+              chunk.data(), chunk.size());
+  received_ += chunk.size();
+  return absl::OkStatus();
+}
+
+absl::StatusOr<PointCloud> CloudAssembler::Take(const std::string& field) {
+  PointCloud c = std::move(cloud_);
+  cloud_ = PointCloud();
+  received_ = 0;
+  if (auto st = c.Validate(); !st.ok()) return Invalid(field, st.message());
+  return c;
+}
+
 absl::StatusOr<PointCloud> CloudFromProto(const v1::PointCloud& msg, const std::string& field,
                                           const Limits& limits) {
   if (auto st = CheckCloudShape(msg.width(), msg.height(), field, limits); !st.ok()) return st;

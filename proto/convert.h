@@ -36,6 +36,26 @@ absl::Status CheckCloudShape(uint64_t width, uint64_t height, const std::string&
 absl::StatusOr<PointCloud> CloudFromBytes(const std::string& xyz, uint32_t width, uint32_t height,
                                           const std::string& field);
 
+// A cloud whose xyz bytes arrive in chunks (the Inspect stream). Each chunk
+// is copied straight into the points: no staging buffer, no second copy.
+class CloudAssembler {
+ public:
+  // Shape checked with CheckCloudShape first; the points stay unset until filled.
+  void Start(uint32_t width, uint32_t height);
+  // InvalidArgument (naming `field`) if the chunk overruns width*height*12 bytes.
+  absl::Status Add(const std::string& chunk, const std::string& field);
+  uint64_t received_bytes() const { return received_; }
+  uint64_t expected_bytes() const { return uint64_t{cloud_.size()} * 12; }
+  bool complete() const { return received_ == expected_bytes(); }
+  // The validated cloud (InvalidArgument on an infinite coordinate); the
+  // assembler is empty afterwards.
+  absl::StatusOr<PointCloud> Take(const std::string& field);
+
+ private:
+  PointCloud cloud_;
+  uint64_t received_ = 0;
+};
+
 // ---- transforms ----
 absl::StatusOr<Eigen::Isometry3d> TransformFromProto(const v1::Transform& msg,
                                                      const std::string& field);

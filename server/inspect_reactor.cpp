@@ -49,8 +49,8 @@ grpc::Status InspectReactor::Consume(const v1::InspectRequest& msg) {
       if (state_ == State::kExpectPart) return InvalidField("view", "the part header must come first");
       if (state_ == State::kInView)
         return InvalidField("view", absl::StrCat("view '", views_.empty() ? "" : "previous",
-                                                 "' is incomplete: ", view_bytes_.size(), " of ",
-                                                 uint64_t{view_width_} * view_height_ * 12, " bytes"));
+                                                 "' is incomplete: ", view_cloud_.received_bytes(),
+                                                 " of ", view_cloud_.expected_bytes(), " bytes"));
       const v1::ViewHeader& v = msg.view();
       const std::string field = absl::StrCat("view[", views_.size(), "]");
       if (auto st = wire::CheckCloudShape(v.width(), v.height(), field, limits); !st.ok()) return ToGrpc(st);
@@ -65,26 +65,18 @@ grpc::Status InspectReactor::Consume(const v1::InspectRequest& msg) {
       scan.name = v.name().empty() ? absl::StrCat("view", views_.size()) : v.name();
       scan.world_from_sensor = *pose;
       views_.push_back(std::move(scan));
-      view_width_ = v.width();
-      view_height_ = v.height();
-      view_bytes_.clear();
-      view_bytes_.reserve(uint64_t{view_width_} * view_height_ * 12);
+      view_cloud_.Start(v.width(), v.height());
       state_ = State::kInView;
       return grpc::Status::OK;
     }
     case v1::InspectRequest::kChunk: {
       if (state_ != State::kInView) return InvalidField("chunk", "a chunk must follow a view header");
-      const uint64_t expected = uint64_t{view_width_} * view_height_ * 12;
-      if (view_bytes_.size() + msg.chunk().xyz().size() > expected)
-        return InvalidField("chunk", absl::StrCat("view '", views_.back().name, "' gets more than its ",
-                                                  expected, " bytes"));
-      view_bytes_ += msg.chunk().xyz();
-      if (view_bytes_.size() == expected) {
-        auto cloud = wire::CloudFromBytes(view_bytes_, view_width_, view_height_,
-                                          absl::StrCat("view '", views_.back().name, "'"));
+      const std::string field = absl::StrCat("view '", views_.back().name, "'");
+      if (auto st = view_cloud_.Add(msg.chunk().xyz(), field); !st.ok()) return ToGrpc(st);
+      if (view_cloud_.complete()) {
+        auto cloud = view_cloud_.Take(field);
         if (!cloud.ok()) return ToGrpc(cloud.status());
         views_.back().cloud_in_sensor = *std::move(cloud);
-        std::string().swap(view_bytes_);  // release the buffer
         state_ = State::kExpectView;
         SendProgress(v1::Progress::STAGE_VIEW_RECEIVED, views_.back().name,
                      views_.back().cloud_in_sensor.size());
@@ -94,8 +86,8 @@ grpc::Status InspectReactor::Consume(const v1::InspectRequest& msg) {
     case v1::InspectRequest::kEnd: {
       if (state_ == State::kInView)
         return InvalidField("end", absl::StrCat("view '", views_.back().name, "' is incomplete: ",
-                                                view_bytes_.size(), " of ",
-                                                uint64_t{view_width_} * view_height_ * 12, " bytes"));
+                                                view_cloud_.received_bytes(), " of ",
+                                                view_cloud_.expected_bytes(), " bytes"));
       if (state_ != State::kExpectView || views_.empty())
         return InvalidField("end", "a part header and at least one view must come first");
       state_ = State::kEnded;

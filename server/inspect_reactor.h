@@ -52,8 +52,7 @@ class InspectReactor final
   v1::PartHeader header_;
   std::shared_ptr<const MeshIndex> part_;  // resolved at the header when sent by hash
   std::vector<ViewScan> views_;
-  std::string view_bytes_;
-  uint32_t view_width_ = 0, view_height_ = 0;
+  wire::CloudAssembler view_cloud_;  // the view whose chunks are arriving
   uint64_t total_points_ = 0;
 
   // Writing side and finish bookkeeping.

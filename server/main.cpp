@@ -8,6 +8,7 @@
 
 #include "absl/strings/ascii.h"
 #include "core/atomic_file.h"
+#include "core/buffer_reuse.h"
 #include "server/run_server.h"
 
 int main(int argc, char** argv) {
@@ -19,6 +20,7 @@ int main(int argc, char** argv) {
   sigaddset(&signals, SIGTERM);
   sigaddset(&signals, SIGINT);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  surfinspect::ReuseFreedLargeBuffers();  // every call moves ~10 MB buffers
   surfinspect::server::ServerOptions o;
   o.service.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   std::string token_file;

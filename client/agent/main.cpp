@@ -17,6 +17,7 @@
 #include <random>
 #include <thread>
 
+#include "core/buffer_reuse.h"
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "client/agent/inbox.h"
@@ -272,6 +273,7 @@ void AddConnection(CLI::App* cmd, AgentArgs& a) {
 
 int main(int argc, char** argv) {
   using namespace surfinspect::client;
+  surfinspect::ReuseFreedLargeBuffers();  // clouds are ~10 MB buffers, over and over
   spdlog::set_default_logger(spdlog::stderr_color_mt("cell-agent"));
   AgentArgs a;
   CLI::App app{"cell-agent: streams a robot cell's scans to surfinspectd and keeps the results"};

@@ -4,8 +4,10 @@
 #include <spdlog/spdlog.h>
 
 #include "client/cli/commands.h"
+#include "core/buffer_reuse.h"
 
 int main(int argc, char** argv) {
+  surfinspect::ReuseFreedLargeBuffers();  // clouds are ~10 MB buffers, over and over
   CLI::App app{"surfinspect: point-cloud filtering, calibration, registration and "
                "error maps against CAD (units: mm)"};
   app.require_subcommand(1);
