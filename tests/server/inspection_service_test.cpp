@@ -409,17 +409,32 @@ TEST(InspectionService, BearerToken) {
   EXPECT_TRUE(ClientFor(open_server)->Filter(req).ok());
 }
 
+// openssl, run by the test: a CA `ca`, a server certificate for
+// localhost/127.0.0.1 and a client certificate `client`, both signed by it,
+// plus a client certificate `stranger` from an unrelated CA.
+void MakeCertificates(const testing::TempDir& dir) {
+  const std::string quiet = " >/dev/null 2>&1";
+  auto ca = [&](const std::string& name) {
+    return "openssl req -x509 -newkey rsa:2048 -nodes -days 2 -subj /CN=" + name + " -keyout " +
+           name + ".key -out " + name + ".crt" + quiet;
+  };
+  auto signed_by = [&](const std::string& name, const std::string& issuer, const std::string& ext) {
+    return "openssl req -newkey rsa:2048 -nodes -subj /CN=" + name + " -keyout " + name +
+           ".key -out " + name + ".csr" + quiet + " && openssl x509 -req -in " + name + ".csr -CA " +
+           issuer + ".crt -CAkey " + issuer + ".key -CAcreateserial -days 2" + ext + " -out " + name +
+           ".crt" + quiet;
+  };
+  const std::string cmd =
+      "cd " + dir.path() + " && " + ca("ca") + " && " + ca("other-ca") +
+      " && printf 'subjectAltName=DNS:localhost,IP:127.0.0.1\\n' > san.ext && " +
+      signed_by("server", "ca", " -extfile san.ext") + " && " + signed_by("client", "ca", "") +
+      " && " + signed_by("stranger", "other-ca", "");
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << "openssl failed: " << cmd;
+}
+
 TEST(InspectionService, TlsWithAGeneratedCertificate) {
   testing::TempDir dir;
-  const std::string cmd =
-      "cd " + dir.path() +
-      " && openssl req -x509 -newkey rsa:2048 -nodes -days 2 -subj /CN=surfinspect-test-ca"
-      " -keyout ca.key -out ca.crt >/dev/null 2>&1"
-      " && openssl req -newkey rsa:2048 -nodes -subj /CN=localhost -keyout server.key -out server.csr >/dev/null 2>&1"
-      " && printf 'subjectAltName=DNS:localhost,IP:127.0.0.1\\n' > san.ext"
-      " && openssl x509 -req -in server.csr -CA ca.crt -CAkey ca.key -CAcreateserial -days 2"
-      " -extfile san.ext -out server.crt >/dev/null 2>&1";
-  ASSERT_EQ(std::system(cmd.c_str()), 0) << "openssl failed";
+  MakeCertificates(dir);
   testing::ServerProcess server({"--tls-cert", dir.File("server.crt"), "--tls-key", dir.File("server.key")});
   ASSERT_TRUE(server.started());
   RemoteOptions tls;
@@ -431,6 +446,29 @@ TEST(InspectionService, TlsWithAGeneratedCertificate) {
   RemoteOptions plain;
   plain.timeout_s = 3;
   EXPECT_FALSE(ClientFor(server, plain)->Filter(req).ok());
+}
+
+// mTLS: only a client whose certificate the --tls-client-ca signed gets in.
+TEST(InspectionService, MutualTlsRequiresAClientCertificateFromTheCa) {
+  testing::TempDir dir;
+  MakeCertificates(dir);
+  testing::ServerProcess server({"--tls-cert", dir.File("server.crt"), "--tls-key",
+                                 dir.File("server.key"), "--tls-client-ca", dir.File("ca.crt")});
+  ASSERT_TRUE(server.started());
+  v1::FilterRequest req;
+  wire::CloudToProto(TestData().views[0].cloud_in_sensor, req.mutable_cloud());
+  RemoteOptions o;
+  o.tls_ca_file = dir.File("ca.crt");
+  o.timeout_s = 3;
+  EXPECT_FALSE(ClientFor(server, o)->Filter(req).ok()) << "no client certificate";
+  o.tls_cert_file = dir.File("stranger.crt");
+  o.tls_key_file = dir.File("stranger.key");
+  EXPECT_FALSE(ClientFor(server, o)->Filter(req).ok()) << "certificate from another CA";
+  o.tls_cert_file = dir.File("client.crt");
+  o.tls_key_file = dir.File("client.key");
+  o.timeout_s = 10;
+  EXPECT_TRUE(ClientFor(server, o)->Filter(req).ok());
+  EXPECT_EQ(*ClientFor(server, o)->Health(), "SERVING");
 }
 
 TEST(InspectionService, OverAdmissionIsResourceExhaustedNotACrash) {
