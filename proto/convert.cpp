@@ -44,7 +44,7 @@ void CloudAssembler::Start(uint32_t width, uint32_t height) {
   cloud_.width = width;
   cloud_.height = height;
   cloud_.points.resize(uint64_t{width} * height);  // Eigen's default constructor leaves them unset
-  received_ = 0;
+  received_ = checked_ = 0;
 }
 
 absl::Status CloudAssembler::Add(const std::string& chunk, const std::string& field) {
@@ -53,14 +53,20 @@ absl::Status CloudAssembler::Add(const std::string& chunk, const std::string& fi
   std::memcpy(static_cast<void*>(reinterpret_cast<char*>(cloud_.points.data()) + received_),
               chunk.data(), chunk.size());
   received_ += chunk.size();
+  // Check the points this chunk completed while they are in cache and the
+  // next chunk is still on the wire, so Take() has nothing left to scan.
+  for (const uint64_t done = received_ / 12; checked_ < done; ++checked_)
+    if (cloud_.points[checked_].array().isInf().any())
+      return Invalid(field, absl::StrCat("point ", checked_, " has an infinite coordinate"));
   return absl::OkStatus();
 }
 
 absl::StatusOr<PointCloud> CloudAssembler::Take(const std::string& field) {
+  if (!complete())
+    return Invalid(field, absl::StrCat("incomplete: ", received_, " of ", expected_bytes(), " bytes"));
   PointCloud c = std::move(cloud_);
   cloud_ = PointCloud();
-  received_ = 0;
-  if (auto st = c.Validate(); !st.ok()) return Invalid(field, st.message());
+  received_ = checked_ = 0;
   return c;
 }
 

@@ -42,18 +42,20 @@ class CloudAssembler {
  public:
   // Shape checked with CheckCloudShape first; the points stay unset until filled.
   void Start(uint32_t width, uint32_t height);
-  // InvalidArgument (naming `field`) if the chunk overruns width*height*12 bytes.
+  // InvalidArgument (naming `field`) if the chunk overruns width*height*12
+  // bytes or completes a point with an infinite coordinate (NaN = no point).
   absl::Status Add(const std::string& chunk, const std::string& field);
   uint64_t received_bytes() const { return received_; }
   uint64_t expected_bytes() const { return uint64_t{cloud_.size()} * 12; }
   bool complete() const { return received_ == expected_bytes(); }
-  // The validated cloud (InvalidArgument on an infinite coordinate); the
+  // The complete, validated cloud (InvalidArgument if incomplete); the
   // assembler is empty afterwards.
   absl::StatusOr<PointCloud> Take(const std::string& field);
 
  private:
   PointCloud cloud_;
   uint64_t received_ = 0;
+  uint64_t checked_ = 0;  // points checked for infinities
 };
 
 // ---- transforms ----

@@ -52,13 +52,20 @@ TEST(CloudAssembler, OverrunAndInfinityAreInvalidAndNamed) {
   EXPECT_NE(over.message().find("view 'top'"), absl::string_view::npos) << over.message();
   EXPECT_EQ(a.received_bytes(), 20u) << "a refused chunk is not half-copied";
 
-  PointCloud bad = Grid(2, 1);
+  EXPECT_EQ(a.Take("view 'top'").status().code(), absl::StatusCode::kInvalidArgument)
+      << "an incomplete cloud is not handed out";
+
+  // An infinity is caught by the chunk that completes its point, even when
+  // the point's bytes are split across chunks.
+  PointCloud bad = Grid(3, 1);
   bad.points[1].y() = INFINITY;
-  a.Start(2, 1);
-  ASSERT_TRUE(a.Add(Bytes(bad), "view 'top'").ok());
-  const auto taken = a.Take("view 'top'");
-  EXPECT_EQ(taken.status().code(), absl::StatusCode::kInvalidArgument);
-  EXPECT_NE(taken.status().message().find("infinite"), absl::string_view::npos);
+  const std::string bytes = Bytes(bad);
+  a.Start(3, 1);
+  ASSERT_TRUE(a.Add(bytes.substr(0, 18), "view 'top'").ok());
+  const absl::Status inf = a.Add(bytes.substr(18, 6), "view 'top'");
+  EXPECT_EQ(inf.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(inf.message().find("point 1 has an infinite coordinate"), absl::string_view::npos)
+      << inf.message();
 }
 
 }  // namespace
