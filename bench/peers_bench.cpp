@@ -10,13 +10,13 @@
 #include <ctime>
 #include <string>
 
-#include "core/buffer_reuse.h"
 #include "bench/peers/calibration_rows.h"
 #include "bench/peers/clustering_rows.h"
 #include "bench/peers/distance_rows.h"
 #include "bench/peers/report.h"
 #include "bench/peers/service_rows.h"
 #include "core/atomic_file.h"
+#include "core/buffer_reuse.h"
 
 int main(int argc, char** argv) {
   surfinspect::ReuseFreedLargeBuffers();  // clouds are ~10 MB buffers, over and over

@@ -17,7 +17,6 @@
 #include <random>
 #include <thread>
 
-#include "core/buffer_reuse.h"
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "client/agent/inbox.h"
@@ -26,6 +25,7 @@
 #include "client/cell/part_outputs.h"
 #include "client/remote/remote_client.h"
 #include "core/atomic_file.h"
+#include "core/buffer_reuse.h"
 #include "core/io_mesh.h"
 #include "core/io_point_cloud.h"
 #include "proto/convert.h"
