@@ -36,16 +36,25 @@ uint64_t Spread10(uint64_t v) {
   return v;
 }
 
+bool Cancelled(const std::atomic<bool>* cancel) {
+  return cancel && cancel->load(std::memory_order_relaxed);
+}
+
+// Polled every this many points in the single-threaded passes below, so a
+// cancelled call stops within milliseconds even on 10^7 points.
+constexpr std::size_t kCancelStride = std::size_t{1} << 16;
+
 // Visiting order for an unorganized cloud: 30-bit Morton codes on a 1024^3
 // grid over the bounds, sorted by an LSD radix sort (stable, so equal codes
-// keep input order). Invalid points go last.
-std::vector<uint32_t> MortonOrder(const PointCloud& cloud) {
+// keep input order). Invalid points go last. Empty if cancelled.
+std::vector<uint32_t> MortonOrder(const PointCloud& cloud, const std::atomic<bool>* cancel) {
   const Bounds3 bounds = ComputeBounds(cloud);
   const std::size_t n = cloud.size();
   const double extent = bounds.empty() ? 0.0 : (bounds.max - bounds.min).maxCoeff();
   const double scale = extent > 0 ? 1023.0 / extent : 0.0;
   std::vector<uint64_t> keys(n), tmp(n);
   for (std::size_t i = 0; i < n; ++i) {
+    if (i % kCancelStride == 0 && Cancelled(cancel)) return {};
     const Eigen::Vector3f& p = cloud.points[i];
     uint64_t code = uint64_t{1} << 30;
     if (PointCloud::IsValid(p)) {
@@ -61,7 +70,10 @@ std::vector<uint32_t> MortonOrder(const PointCloud& cloud) {
     std::array<std::size_t, 2049> start{};
     for (uint64_t k : keys) ++start[((k >> shift) & 2047) + 1];
     for (int d = 0; d < 2048; ++d) start[d + 1] += start[d];
-    for (uint64_t k : keys) tmp[start[(k >> shift) & 2047]++] = k;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (i % kCancelStride == 0 && Cancelled(cancel)) return {};
+      tmp[start[(keys[i] >> shift) & 2047]++] = keys[i];
+    }
     keys.swap(tmp);
   }
   std::vector<uint32_t> order(n);
@@ -95,7 +107,10 @@ absl::Status QueryClosestEach(
   if (n == 0) return absl::OkStatus();
   // A grid is already coherent row by row; anything else gets Morton order.
   std::vector<uint32_t> order;
-  if (settings.coherent_start && !points.organized() && n <= UINT32_MAX) order = MortonOrder(points);
+  if (settings.coherent_start && !points.organized() && n <= UINT32_MAX) {
+    order = MortonOrder(points, cancel);
+    if (order.empty()) return absl::CancelledError("closest-point query cancelled");
+  }
 
   const double max_d = settings.max_distance_mm;
   std::atomic<bool> cancelled{false};
@@ -135,7 +150,7 @@ absl::Status QueryClosestEach(
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks),
                       [&](const tbb::blocked_range<std::size_t>& range) {
                         for (std::size_t c = range.begin(); c != range.end(); ++c) {
-                          if (cancel && cancel->load(std::memory_order_relaxed)) {
+                          if (Cancelled(cancel)) {
                             cancelled.store(true, std::memory_order_relaxed);
                             return;
                           }

@@ -147,7 +147,8 @@ void InspectReactor::Compute() {
                                           : v1::Progress::STAGE_ERROR_MAP;
         SendProgress(s, view, points);
       };
-      auto result = InspectPart(*part, world_from_part, std::move(views_), settings, progress, &cancel_);
+      auto result = InspectPart(*part, world_from_part, std::move(views_), settings, progress,
+                                &cancel_.flag());
       if (!result.ok()) {
         st = ToGrpc(result.status());
       } else {
@@ -236,7 +237,8 @@ void InspectReactor::MaybeFinishLocked() {
   finished_ = true;
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  service_->LogCall(request_id_, "Inspect", ctx_->peer(), total_points_, final_status_, seconds);
+  service_->LogCall(request_id_, "Inspect", ctx_->peer(), total_points_, final_status_, seconds,
+                    cancel_.MillisecondsSinceRaised());
   service_->metrics()->RecordRpc("Inspect", CodeName(final_status_.error_code()), seconds);
   if (final_status_.ok()) service_->metrics()->AddPoints(total_points_);
   if (admitted_) service_->metrics()->CallEnded();

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/registration.h"
+#include "server/cancel_signal.h"
 #include "server/inspection_service.h"
 
 namespace surfinspect::server {
@@ -27,7 +28,7 @@ class InspectReactor final
   InspectReactor(InspectionService* service, grpc::CallbackServerContext* ctx);
   void OnReadDone(bool ok) override;
   void OnWriteDone(bool ok) override;
-  void OnCancel() override { cancel_.store(true); }
+  void OnCancel() override { cancel_.Raise(); }
   void OnDone() override { delete this; }
 
  private:
@@ -44,7 +45,7 @@ class InspectReactor final
   grpc::CallbackServerContext* ctx_;
   std::string request_id_;
   std::chrono::steady_clock::time_point start_;
-  std::atomic<bool> cancel_{false};
+  CancelSignal cancel_;
 
   // Reading side (only touched by OnReadDone, which gRPC serialises).
   v1::InspectRequest in_;

@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "absl/strings/str_cat.h"
@@ -13,6 +14,7 @@
 #include "core/mesh_hash.h"
 #include "core/registration.h"
 #include "core/transform.h"
+#include "server/cancel_signal.h"
 #include "server/status_mapping.h"
 
 namespace surfinspect::server {
@@ -40,15 +42,15 @@ class HeavyCall final : public grpc::ServerUnaryReactor {
                         absl::StrCat("server busy: ", service_->config().max_admitted_calls,
                                      " heavy calls already admitted; retry with backoff")));
   }
-  void OnCancel() override { cancel_.store(true); }
+  void OnCancel() override { cancel_.Raise(); }
   void OnDone() override { delete this; }
 
  private:
   void Run() {
     grpc::Status st;
     try {
-      st = cancel_.load() ? grpc::Status(grpc::StatusCode::CANCELLED, "cancelled before start")
-                          : work_(cancel_);
+      st = cancel_.raised() ? grpc::Status(grpc::StatusCode::CANCELLED, "cancelled before start")
+                            : work_(cancel_.flag());
     } catch (const std::exception& e) {  // never let an exception cross the RPC
       st = grpc::Status(grpc::StatusCode::INTERNAL, absl::StrCat("internal error: ", e.what()));
     }
@@ -56,7 +58,8 @@ class HeavyCall final : public grpc::ServerUnaryReactor {
   }
   void Done(const grpc::Status& st) {
     const double seconds = std::chrono::duration<double>(Clock::now() - start_).count();
-    service_->LogCall(request_id_, method_, ctx_->peer(), points_, st, seconds);
+    service_->LogCall(request_id_, method_, ctx_->peer(), points_, st, seconds,
+                      cancel_.MillisecondsSinceRaised());
     service_->metrics()->RecordRpc(method_, CodeName(st.error_code()), seconds);
     if (st.ok()) service_->metrics()->AddPoints(points_);
     if (admitted_) service_->metrics()->CallEnded();
@@ -71,7 +74,7 @@ class HeavyCall final : public grpc::ServerUnaryReactor {
   std::string request_id_;
   Clock::time_point start_;
   bool admitted_ = false;
-  std::atomic<bool> cancel_{false};
+  CancelSignal cancel_;
 };
 
 grpc::Status FromCore(const absl::Status& st) { return ToGrpc(st); }
@@ -140,21 +143,25 @@ std::string InspectionService::RequestId(const grpc::CallbackServerContext* ctx)
 
 void InspectionService::LogCall(const std::string& request_id, const std::string& method,
                                 const std::string& peer, uint64_t points, const grpc::Status& st,
-                                double seconds) {
+                                double seconds, double stop_ms) {
   if (config_.json_logs) {
     // spdlog does not escape JSON; nlohmann does.
-    const nlohmann::json line = {{"event", "rpc"},          {"request_id", request_id},
-                                 {"method", method},        {"peer", peer},
-                                 {"points", points},        {"code", CodeName(st.error_code())},
-                                 {"message", st.error_message()}, {"seconds", seconds}};
+    nlohmann::json line = {{"event", "rpc"},          {"request_id", request_id},
+                           {"method", method},        {"peer", peer},
+                           {"points", points},        {"code", CodeName(st.error_code())},
+                           {"message", st.error_message()}, {"seconds", seconds}};
+    if (!std::isnan(stop_ms)) line["stopped_after_cancel_ms"] = stop_ms;
     spdlog::info("{}", line.dump());
     return;
   }
+  const std::string stopped =
+      std::isnan(stop_ms) ? "" : fmt::format(", work stopped {:.1f} ms after the cancellation", stop_ms);
   if (st.ok())
-    spdlog::info("[{}] {} from {}: OK, {} points, {:.3f} s", request_id, method, peer, points, seconds);
+    spdlog::info("[{}] {} from {}: OK, {} points, {:.3f} s{}", request_id, method, peer, points,
+                 seconds, stopped);
   else
-    spdlog::warn("[{}] {} from {}: {} ({}), {} points, {:.3f} s", request_id, method, peer,
-                 CodeName(st.error_code()), st.error_message(), points, seconds);
+    spdlog::warn("[{}] {} from {}: {} ({}), {} points, {:.3f} s{}", request_id, method, peer,
+                 CodeName(st.error_code()), st.error_message(), points, seconds, stopped);
 }
 
 grpc::ServerUnaryReactor* InspectionService::RunHeavy(grpc::CallbackServerContext* ctx,

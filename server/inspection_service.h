@@ -62,8 +62,10 @@ class InspectionService final : public v1::InspectionService::CallbackService {
                            const std::string& field, std::shared_ptr<const MeshIndex>* out);
   // Request id: the client's x-request-id, or a generated one.
   std::string RequestId(const grpc::CallbackServerContext* ctx);
+  // `stop_ms`: for a cancelled call, how long its work ran on after the
+  // cancellation (NaN otherwise).
   void LogCall(const std::string& request_id, const std::string& method, const std::string& peer,
-               uint64_t points, const grpc::Status& status, double seconds);
+               uint64_t points, const grpc::Status& status, double seconds, double stop_ms = NAN);
 
  private:
   using Work = std::function<grpc::Status(const std::atomic<bool>& cancel)>;
