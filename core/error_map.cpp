@@ -7,13 +7,10 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "core/cancel.h"
 
 namespace surfinspect {
 namespace {
-
-bool Cancelled(const std::atomic<bool>* cancel) {
-  return cancel && cancel->load(std::memory_order_relaxed);
-}
 
 // n copies of `value`, written slice by slice with `cancel` polled between
 // slices: first-touching the ~20 bytes per point of results costs 0.1-0.3 s
@@ -25,7 +22,7 @@ bool FillUnlessCancelled(std::vector<T>& v, std::size_t n, const T& value,
   v.clear();
   v.reserve(n);
   for (std::size_t i = 0; i < n; i += kSlice) {
-    if (Cancelled(cancel)) return false;
+    if (IsCancelled(cancel)) return false;
     v.insert(v.end(), std::min(kSlice, n - i), value);
   }
   return true;
@@ -165,7 +162,7 @@ absl::StatusOr<ErrorMapResult> ComputeErrorMap(const MeshIndex& index,
                                                const std::atomic<bool>* cancel) {
   if (auto st = CheckSettings(settings); !st.ok()) return st;
   const absl::Status cancelled = absl::CancelledError("error map cancelled");
-  if (Cancelled(cancel)) return cancelled;
+  if (IsCancelled(cancel)) return cancelled;
   if (auto st = cloud_in_world.Validate(); !st.ok()) return st;
   if (!world_from_part.matrix().allFinite())
     return absl::InvalidArgumentError("error map: world_from_part is not finite");

@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/absolute_orientation.h"
+#include "core/cancel.h"
 
 namespace surfinspect {
 namespace {
@@ -164,7 +165,7 @@ absl::StatusOr<IcpResult> RunIcp(const MeshIndex& mesh, const PointCloud& points
   Eigen::Isometry3d pose = initial;
   double gate = s.max_correspondence_mm, previous_gate = gate;
   for (int it = 0;; ++it) {
-    if (cancel && cancel->load(std::memory_order_relaxed)) return absl::CancelledError("icp cancelled");
+    if (IsCancelled(cancel)) return absl::CancelledError("icp cancelled");
     auto pairs = Correspond(mesh, pts, pose, gate, s, cancel);
     if (!pairs.ok()) return pairs.status();
     if (pairs->p.size() < 6)

@@ -3,6 +3,7 @@
 #include "absl/strings/str_cat.h"
 #include <nlohmann/json.hpp>
 
+#include "core/cancel.h"
 #include "core/error_map_output.h"
 #include "core/error_map_png.h"
 #include "core/transform.h"
@@ -40,7 +41,7 @@ absl::StatusOr<InspectionResult> InspectPart(const MeshIndex& part,
   if (progress)
     for (std::size_t k = 0; k < views.size(); ++k)
       progress(InspectionStage::kViewRegistered, views[k].name, out.merged.points_per_view[k]);
-  if (cancel && cancel->load()) return absl::CancelledError("inspect cancelled");
+  if (IsCancelled(cancel)) return absl::CancelledError("inspect cancelled");
   auto map = ComputeErrorMap(part, out.merged.cloud_in_world, world_from_part, settings.error_map, cancel);
   if (!map.ok()) return map.status();
   out.error_map = *std::move(map);

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/cancel.h"
 #include "core/link_row_masks.h"
 
 namespace surfinspect {
@@ -82,7 +83,7 @@ absl::Status ClusterLinksOrganized(const PointCloud& cloud,
 
   // Pass 1: runs and their unions, row by row.
   for (uint32_t r = 0; r < h; ++r) {
-    if (cancel && cancel->load(std::memory_order_relaxed))
+    if (IsCancelled(cancel))
       return absl::CancelledError("link clustering: cancelled");
     RowSoA& cur = rows[r & 1];
     const RowSoA& up = rows[(r + 1) & 1];

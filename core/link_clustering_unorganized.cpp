@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/cancel.h"
 
 namespace surfinspect {
 namespace {
@@ -84,7 +85,7 @@ absl::Status ClusterLinksUnorganized(const PointCloud& cloud,
                                      LinkClusteringResult& result,
                                      const std::atomic<bool>* cancel) {
   if (auto st = internal::CheckInput(cloud, settings); !st.ok()) return st;
-  auto cancelled = [&] { return cancel && cancel->load(std::memory_order_relaxed); };
+  auto cancelled = [&] { return IsCancelled(cancel); };
   const std::size_t n = cloud.size();
   result.input_points = n;
   result.organized_path = false;

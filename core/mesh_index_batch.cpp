@@ -18,6 +18,7 @@
 #include <new>
 
 #include "absl/strings/str_cat.h"
+#include "core/cancel.h"
 #include "core/mesh_index.h"
 
 namespace surfinspect {
@@ -36,10 +37,6 @@ uint64_t Spread10(uint64_t v) {
   return v;
 }
 
-bool Cancelled(const std::atomic<bool>* cancel) {
-  return cancel && cancel->load(std::memory_order_relaxed);
-}
-
 // Polled every this many points in the single-threaded passes below, so a
 // cancelled call stops within milliseconds even on 10^7 points.
 constexpr std::size_t kCancelStride = std::size_t{1} << 16;
@@ -54,7 +51,7 @@ std::vector<uint32_t> MortonOrder(const PointCloud& cloud, const std::atomic<boo
   const double scale = extent > 0 ? 1023.0 / extent : 0.0;
   std::vector<uint64_t> keys(n), tmp(n);
   for (std::size_t i = 0; i < n; ++i) {
-    if (i % kCancelStride == 0 && Cancelled(cancel)) return {};
+    if (i % kCancelStride == 0 && IsCancelled(cancel)) return {};
     const Eigen::Vector3f& p = cloud.points[i];
     uint64_t code = uint64_t{1} << 30;
     if (PointCloud::IsValid(p)) {
@@ -71,7 +68,7 @@ std::vector<uint32_t> MortonOrder(const PointCloud& cloud, const std::atomic<boo
     for (uint64_t k : keys) ++start[((k >> shift) & 2047) + 1];
     for (int d = 0; d < 2048; ++d) start[d + 1] += start[d];
     for (std::size_t i = 0; i < n; ++i) {
-      if (i % kCancelStride == 0 && Cancelled(cancel)) return {};
+      if (i % kCancelStride == 0 && IsCancelled(cancel)) return {};
       tmp[start[(keys[i] >> shift) & 2047]++] = keys[i];
     }
     keys.swap(tmp);
@@ -150,7 +147,7 @@ absl::Status QueryClosestEach(
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks),
                       [&](const tbb::blocked_range<std::size_t>& range) {
                         for (std::size_t c = range.begin(); c != range.end(); ++c) {
-                          if (Cancelled(cancel)) {
+                          if (IsCancelled(cancel)) {
                             cancelled.store(true, std::memory_order_relaxed);
                             return;
                           }
