@@ -452,7 +452,7 @@ void MakeCertificates(const testing::TempDir& dir) {
 
 TEST(InspectionService, TlsWithAGeneratedCertificate) {
   testing::TempDir dir;
-  MakeCertificates(dir);
+  ASSERT_NO_FATAL_FAILURE(MakeCertificates(dir));
   testing::ServerProcess server({"--tls-cert", dir.File("server.crt"), "--tls-key", dir.File("server.key")});
   ASSERT_TRUE(server.started());
   RemoteOptions tls;
@@ -469,7 +469,7 @@ TEST(InspectionService, TlsWithAGeneratedCertificate) {
 // mTLS: only a client whose certificate the --tls-client-ca signed gets in.
 TEST(InspectionService, MutualTlsRequiresAClientCertificateFromTheCa) {
   testing::TempDir dir;
-  MakeCertificates(dir);
+  ASSERT_NO_FATAL_FAILURE(MakeCertificates(dir));
   testing::ServerProcess server({"--tls-cert", dir.File("server.crt"), "--tls-key",
                                  dir.File("server.key"), "--tls-client-ca", dir.File("ca.crt")});
   ASSERT_TRUE(server.started());
