@@ -1,7 +1,6 @@
 #include "core/error_map.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <new>
 

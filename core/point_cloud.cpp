@@ -32,7 +32,11 @@ absl::Status PointCloud::Validate() const {
     return absl::InvalidArgumentError(
         absl::StrCat("cloud: width*height = ", width, "*", height,
                      " does not match ", points.size(), " points"));
-  for (std::size_t i = 0; i < points.size(); ++i) {
+  return ValidatePoints(0, points.size());
+}
+
+absl::Status PointCloud::ValidatePoints(std::size_t first, std::size_t last) const {
+  for (std::size_t i = first; i < last; ++i) {
     const auto& p = points[i];
     if (IsValid(p)) continue;
     for (int k = 0; k < 3; ++k)

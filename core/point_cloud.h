@@ -45,6 +45,9 @@ struct PointCloud {
   // Checks width * height == size(). Coordinates may be NaN (no data) but a
   // point with one finite and one infinite coordinate is rejected.
   absl::Status Validate() const;
+  // The coordinate check alone, on points [first, last) (last <= size()),
+  // for clouds filled piece by piece.
+  absl::Status ValidatePoints(std::size_t first, std::size_t last) const;
 };
 
 // Axis-aligned bounds of the valid points; empty() when there are none.

@@ -55,9 +55,9 @@ absl::Status CloudAssembler::Add(const std::string& chunk, const std::string& fi
   received_ += chunk.size();
   // Check the points this chunk completed while they are in cache and the
   // next chunk is still on the wire, so Take() has nothing left to scan.
-  for (const uint64_t done = received_ / 12; checked_ < done; ++checked_)
-    if (cloud_.points[checked_].array().isInf().any())
-      return Invalid(field, absl::StrCat("point ", checked_, " has an infinite coordinate"));
+  const uint64_t done = received_ / 12;
+  if (auto st = cloud_.ValidatePoints(checked_, done); !st.ok()) return Invalid(field, st.message());
+  checked_ = done;
   return absl::OkStatus();
 }
 
