@@ -72,7 +72,8 @@ Data& Get() {
       for (uint32_t col = 0; col < 1000; ++col) {
         const double uu = 1.2 * col / 1000, ww = -1.2 + 2.4 * row / 1000;
         d.organized.points[row * 1000 + col] =
-            TorusPoint(uu, ww, 0.5 * std::sin(uu * 20) * std::cos(ww * 9) + noise(rng)).cast<float>();
+            TorusPoint(uu, ww, 0.5 * std::sin(uu * 20) * std::cos(ww * 9) + noise(rng))
+                .cast<float>();
       }
     return d;
   }();
@@ -111,7 +112,8 @@ void BM_BuildIndex(benchmark::State& state) {
 
 void BM_Ours(benchmark::State& state, bool organized, bool coherent) {
   const PointCloud& cloud = organized ? Get().organized : Get().shuffled;
-  const std::string name = std::string(organized ? "organized" : "shuffled") + (coherent ? "/coherent" : "/plain");
+  const std::string name =
+      std::string(organized ? "organized" : "shuffled") + (coherent ? "/coherent" : "/plain");
   Timed(state, name, cloud.size(), [&] {
     BatchQuerySettings s;
     s.threads = kThreads;
@@ -163,9 +165,8 @@ void BM_Open3DDistance(benchmark::State& state, bool organized) {
   const PointCloud& cloud = organized ? Get().organized : Get().shuffled;
   auto scene = Open3DScene();
   const o3c::Tensor q = Open3DPoints(cloud);
-  Timed(state, organized ? "open3d/organized" : "open3d/shuffled", cloud.size(), [&] {
-    benchmark::DoNotOptimize(scene->ComputeDistance(q, kThreads));
-  });
+  Timed(state, organized ? "open3d/organized" : "open3d/shuffled", cloud.size(),
+        [&] { benchmark::DoNotOptimize(scene->ComputeDistance(q, kThreads)); });
 }
 #endif
 
@@ -179,9 +180,11 @@ void PrintSummary() {
     std::printf("%-20s %.3f s  %.2f Mpoints/s\n", k, best(k), 1.0 / best(k));
 #ifdef SURFINSPECT_HAVE_OPEN3D
   std::printf("open3d build+commit: %.3f s\n", best("open3d_build"));
-  std::printf("throughput vs Open3D (1M shuffled): coherent %.1fx, plain %.1fx, error map %.1fx (goal >= 5x)\n",
-              best("open3d/shuffled") / best("shuffled/coherent"), best("open3d/shuffled") / best("shuffled/plain"),
-              best("open3d/shuffled") / best("errormap"));
+  std::printf(
+      "throughput vs Open3D (1M shuffled): coherent %.1fx, plain %.1fx, error map %.1fx (goal >= "
+      "5x)\n",
+      best("open3d/shuffled") / best("shuffled/coherent"),
+      best("open3d/shuffled") / best("shuffled/plain"), best("open3d/shuffled") / best("errormap"));
   std::printf("throughput vs Open3D (organized): coherent %.1fx, plain %.1fx\n",
               best("open3d/organized") / best("organized/coherent"),
               best("open3d/organized") / best("organized/plain"));
@@ -201,13 +204,15 @@ void PrintSummary() {
       sum += diff;
       over_1e4 += diff > 1e-4;
     }
-    std::printf("agreement with Open3D (%s): max |diff| %.2e mm, mean %.2e mm, %zu of %zu over 1e-4 mm\n",
-                organized ? "organized" : "shuffled", max_diff, sum / ours.size(), over_1e4, ours.size());
+    std::printf(
+        "agreement with Open3D (%s): max |diff| %.2e mm, mean %.2e mm, %zu of %zu over 1e-4 mm\n",
+        organized ? "organized" : "shuffled", max_diff, sum / ours.size(), over_1e4, ours.size());
   }
 #else
   std::printf("Open3D not found: no peer comparison\n");
 #endif
-  std::printf("organized, coherent start vs none: %.2fx\n", best("organized/plain") / best("organized/coherent"));
+  std::printf("organized, coherent start vs none: %.2fx\n",
+              best("organized/plain") / best("organized/coherent"));
 }
 
 }  // namespace
@@ -215,20 +220,35 @@ void PrintSummary() {
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   Get();  // build the data outside the timings
-  benchmark::RegisterBenchmark("BM_BuildIndex", BM_BuildIndex)->Unit(benchmark::kMillisecond)->Iterations(3);
+  benchmark::RegisterBenchmark("BM_BuildIndex", BM_BuildIndex)
+      ->Unit(benchmark::kMillisecond)
+      ->Iterations(3);
   for (const bool organized : {false, true})
     for (const bool coherent : {true, false})
       benchmark::RegisterBenchmark(
-          (std::string("BM_Ours/") + (organized ? "organized" : "shuffled") + (coherent ? "/coherent" : "/plain")).c_str(),
+          (std::string("BM_Ours/") + (organized ? "organized" : "shuffled") +
+           (coherent ? "/coherent" : "/plain"))
+              .c_str(),
           [organized, coherent](benchmark::State& s) { BM_Ours(s, organized, coherent); })
-          ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(5);
-  benchmark::RegisterBenchmark("BM_ErrorMap/shuffled", BM_ErrorMap)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(5);
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime()
+          ->Iterations(5);
+  benchmark::RegisterBenchmark("BM_ErrorMap/shuffled", BM_ErrorMap)
+      ->Unit(benchmark::kMillisecond)
+      ->UseRealTime()
+      ->Iterations(5);
 #ifdef SURFINSPECT_HAVE_OPEN3D
-  benchmark::RegisterBenchmark("BM_Open3D/build", BM_Open3DBuild)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+  benchmark::RegisterBenchmark("BM_Open3D/build", BM_Open3DBuild)
+      ->Unit(benchmark::kMillisecond)
+      ->UseRealTime()
+      ->Iterations(2);
   for (const bool organized : {false, true})
-    benchmark::RegisterBenchmark(organized ? "BM_Open3D/organized" : "BM_Open3D/shuffled",
-                                 [organized](benchmark::State& s) { BM_Open3DDistance(s, organized); })
-        ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+    benchmark::RegisterBenchmark(
+        organized ? "BM_Open3D/organized" : "BM_Open3D/shuffled",
+        [organized](benchmark::State& s) { BM_Open3DDistance(s, organized); })
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime()
+        ->Iterations(3);
 #endif
   benchmark::RunSpecifiedBenchmarks();
   PrintSummary();

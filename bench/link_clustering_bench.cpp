@@ -17,12 +17,12 @@
 #include <pcl/segmentation/euclidean_cluster_comparator.h>
 #include <pcl/segmentation/extract_clusters.h>
 #include <pcl/segmentation/organized_connected_component_segmentation.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
 #include <map>
 #include <random>
-#include <unistd.h>
 
 #include "core/demo_cell.h"
 #include "core/link_clustering.h"
@@ -179,7 +179,8 @@ void PclEuclidean(benchmark::State& state, const pcl::PointCloud<pcl::PointXYZ>:
 void BM_PclEuclideanScan(benchmark::State& s) { PclEuclidean(s, GetData().pcl_scan_points); }
 void BM_PclEuclideanMillion(benchmark::State& s) { PclEuclidean(s, GetData().pcl_million); }
 
-#define FAST(bm) BENCHMARK(bm)->Unit(benchmark::kMillisecond)->Repetitions(9)->ReportAggregatesOnly(true)
+#define FAST(bm) \
+  BENCHMARK(bm)->Unit(benchmark::kMillisecond)->Repetitions(9)->ReportAggregatesOnly(true)
 FAST(BM_OursGrid)->Arg(8)->Arg(4);
 FAST(BM_OursGridInspectionPreset);
 FAST(BM_OursGridFreshResult);
@@ -187,9 +188,15 @@ FAST(BM_ReadScanOnce);
 FAST(BM_PclOrganizedComponents);
 FAST(BM_OursUnorganizedScan);
 FAST(BM_OursUnorganizedMillion);
-BENCHMARK(BM_PclEuclideanScan)->Unit(benchmark::kMillisecond)->Iterations(1)->Repetitions(3)
+BENCHMARK(BM_PclEuclideanScan)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1)
+    ->Repetitions(3)
     ->ReportAggregatesOnly(true);
-BENCHMARK(BM_PclEuclideanMillion)->Unit(benchmark::kMillisecond)->Iterations(1)->Repetitions(3)
+BENCHMARK(BM_PclEuclideanMillion)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1)
+    ->Repetitions(3)
     ->ReportAggregatesOnly(true);
 
 // Keeps each benchmark's median real time (seconds) for the ratio table.
@@ -199,7 +206,8 @@ class MedianReporter : public benchmark::ConsoleReporter {
   void ReportRuns(const std::vector<Run>& runs) override {
     for (const Run& r : runs)
       if (r.aggregate_name == "median")
-        median_s[r.run_name.function_name + (r.run_name.args.empty() ? "" : "/" + r.run_name.args)] =
+        median_s[r.run_name.function_name +
+                 (r.run_name.args.empty() ? "" : "/" + r.run_name.args)] =
             r.GetAdjustedRealTime() / benchmark::GetTimeUnitMultiplier(r.time_unit);
     ConsoleReporter::ReportRuns(runs);
   }
@@ -215,7 +223,10 @@ int main(int argc, char** argv) {
                                                 : benchmark::ConsoleReporter::OO_Tabular);
   benchmark::RunSpecifiedBenchmarks(&reporter);
   const auto& m = reporter.median_s;
-  auto get = [&](const char* k) { auto it = m.find(k); return it == m.end() ? 0.0 : it->second; };
+  auto get = [&](const char* k) {
+    auto it = m.find(k);
+    return it == m.end() ? 0.0 : it->second;
+  };
   auto ratio = [&](const char* peer, const char* ours) {
     if (get(peer) > 0 && get(ours) > 0)
       std::printf("  %-28s %9.3f ms / %-24s %8.3f ms = %7.1fx\n", peer, 1e3 * get(peer), ours,

@@ -25,8 +25,10 @@ int main(int argc, char** argv) {
   // (e.g. "service") and prints its rows without touching latest.md.
   std::string results_dir = "bench/results", only;
   for (int i = 1; i < argc; ++i) {
-    if (std::string(argv[i]) == "--only" && i + 1 < argc) only = argv[++i];
-    else results_dir = argv[i];
+    if (std::string(argv[i]) == "--only" && i + 1 < argc)
+      only = argv[++i];
+    else
+      results_dir = argv[i];
   }
   const auto start = std::chrono::steady_clock::now();
   std::vector<Row> rows;
@@ -37,15 +39,16 @@ int main(int argc, char** argv) {
     const std::size_t before = rows.size();
     fn();
     for (std::size_t i = before; i < rows.size(); ++i)
-      std::fprintf(stderr, "  %s: ours %s, peer %s, %s\n", rows[i].what.c_str(), rows[i].ours.c_str(),
-                   rows[i].peer.c_str(), rows[i].ratio.c_str());
+      std::fprintf(stderr, "  %s: ours %s, peer %s, %s\n", rows[i].what.c_str(),
+                   rows[i].ours.c_str(), rows[i].peer.c_str(), rows[i].ratio.c_str());
   };
   section("link clustering", [&] { AddClusteringRows(rows); });
   section("closest-point distances", [&] { AddDistanceRows(rows, scaling); });
   section("ICP calibration", [&] { AddCalibrationRows(rows); });
   section("scan simulator", [&] { AddSimulatorRow(rows); });
   section("service", [&] { AddServiceRows(rows); });
-  const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double total =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   char date[32];
   const std::time_t now = std::time(nullptr);
@@ -53,7 +56,8 @@ int main(int argc, char** argv) {
   std::string md = "# surfinspect vs PCL / Open3D\n\n";
   md += "Measured " + std::string(date) + " on " + CpuModel() + ", " + std::to_string(CoreCount()) +
         " cores, by `./run bench` (build/bin/peers_bench); the whole comparison took " +
-        Fmt("%.0f s", total) + ". Times are medians of repeated runs (single runs for the slowest peers). " +
+        Fmt("%.0f s", total) +
+        ". Times are medians of repeated runs (single runs for the slowest peers). " +
 #ifdef SURFINSPECT_HAVE_OPEN3D
         "Open3D: found. "
 #else
@@ -65,7 +69,8 @@ int main(int argc, char** argv) {
   if (!only.empty()) return 0;
   const std::string path = results_dir + "/latest.md";
   if (auto st = surfinspect::WriteStringAtomically(path, md); !st.ok()) {
-    std::fprintf(stderr, "peers_bench: cannot write %s: %s\n", path.c_str(), std::string(st.message()).c_str());
+    std::fprintf(stderr, "peers_bench: cannot write %s: %s\n", path.c_str(),
+                 std::string(st.message()).c_str());
     return 1;
   }
   std::fprintf(stderr, "[peers_bench] wrote %s\n", path.c_str());

@@ -13,19 +13,17 @@ namespace {
 using surfinspect::TriangleMesh;
 using surfinspect::bench::WavySheet;
 
-
 void BM_SimulateScan(benchmark::State& state) {
   const TriangleMesh mesh = WavySheet(224, 300);  // 100,352 triangles
-  const Eigen::Isometry3d world_from_sensor =
-      surfinspect::LookAt({10, -20, 400}, {0, 0, 0});
+  const Eigen::Isometry3d world_from_sensor = surfinspect::LookAt({10, -20, 400}, {0, 0, 0});
   surfinspect::ScanOptions opt;
   opt.noise_sigma_mm = 0.015;
   opt.pulse_fraction = 0.003;
   opt.stripes = true;
   std::size_t hits = 0;
   for (auto _ : state) {
-    auto scan = surfinspect::SimulateScan(mesh, Eigen::Isometry3d::Identity(), world_from_sensor,
-                                          {}, opt);
+    auto scan =
+        surfinspect::SimulateScan(mesh, Eigen::Isometry3d::Identity(), world_from_sensor, {}, opt);
     if (!scan.ok()) state.SkipWithError(std::string(scan.status().message()).c_str());
     hits = scan->hits;
     benchmark::DoNotOptimize(scan);

@@ -40,10 +40,9 @@ absl::StatusOr<Eigen::Isometry3d> HornAbsoluteOrientation(const std::vector<Eige
                syz = m(1, 2), szx = m(2, 0), szy = m(2, 1), szz = m(2, 2);
   // The symmetric 4x4 N whose top eigenvector is the optimal unit quaternion.
   Eigen::Matrix4d nm;
-  nm << sxx + syy + szz, syz - szy, szx - sxz, sxy - syx,
-        syz - szy, sxx - syy - szz, sxy + syx, szx + sxz,
-        szx - sxz, sxy + syx, -sxx + syy - szz, syz + szy,
-        sxy - syx, szx + sxz, syz + szy, -sxx - syy + szz;
+  nm << sxx + syy + szz, syz - szy, szx - sxz, sxy - syx, syz - szy, sxx - syy - szz, sxy + syx,
+      szx + sxz, szx - sxz, sxy + syx, -sxx + syy - szz, syz + szy, sxy - syx, szx + sxz, syz + szy,
+      -sxx - syy + szz;
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> eig(nm);
   const Eigen::Vector4d ev = eig.eigenvalues();
   // Collinear (or coincident) points leave a rotation about the line free:

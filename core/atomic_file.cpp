@@ -46,8 +46,8 @@ absl::Status WriteFileAtomically(
   if (st.ok()) {
     SyncFile(tmp);
     if (std::rename(tmp.c_str(), path.c_str()) != 0)
-      st = absl::InternalError(absl::StrCat("cannot rename ", tmp, " to ", path, ": ",
-                                            std::strerror(errno)));
+      st = absl::InternalError(
+          absl::StrCat("cannot rename ", tmp, " to ", path, ": ", std::strerror(errno)));
   }
   if (!st.ok()) std::remove(tmp.c_str());
   return st;
@@ -64,17 +64,15 @@ absl::Status WriteStringAtomically(const std::string& path, const std::string& b
   });
 }
 
-absl::StatusOr<std::string> ReadFileToString(const std::string& path,
-                                             std::size_t max_bytes) {
+absl::StatusOr<std::string> ReadFileToString(const std::string& path, std::size_t max_bytes) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return absl::NotFoundError(absl::StrCat(path, ": cannot open"));
   in.seekg(0, std::ios::end);
   const auto size = in.tellg();
   if (size < 0) return absl::InvalidArgumentError(absl::StrCat(path, ": not a regular file"));
   if (static_cast<std::size_t>(size) > max_bytes)
-    return absl::ResourceExhaustedError(
-        absl::StrCat(path, ": ", static_cast<long long>(size), " bytes exceeds the limit of ",
-                     max_bytes));
+    return absl::ResourceExhaustedError(absl::StrCat(path, ": ", static_cast<long long>(size),
+                                                     " bytes exceeds the limit of ", max_bytes));
   std::string bytes(static_cast<std::size_t>(size), '\0');
   in.seekg(0);
   in.read(bytes.data(), size);

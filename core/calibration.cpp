@@ -35,7 +35,8 @@ double DegeneracyRatio(const IcpResult& icp) {
   Eigen::Matrix<double, 6, 6> scale = Eigen::Matrix<double, 6, 6>::Identity();
   scale.topLeftCorner<3, 3>() *= 1.0 / l;
   h = scale * h * scale;
-  const Eigen::Matrix<double, 6, 1> ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>>(h).eigenvalues();
+  const Eigen::Matrix<double, 6, 1> ev =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>>(h).eigenvalues();
   return ev(5) > 0 ? std::max(0.0, ev(0)) / ev(5) : 0.0;
 }
 
@@ -137,7 +138,8 @@ absl::StatusOr<CalibrationResult> CalibrateViewpoint(
     scan = &filtered;
   }
 
-  Eigen::Isometry3d initial_gauge_from_sensor = world_from_gauge.inverse() * initial_world_from_sensor;
+  Eigen::Isometry3d initial_gauge_from_sensor =
+      world_from_gauge.inverse() * initial_world_from_sensor;
   if (s.coarse_search_deg > 0) {
     auto coarse = CoarseSearch(gauge, *scan, initial_gauge_from_sensor, s, cancel);
     if (!coarse.ok()) return coarse.status();
@@ -168,10 +170,11 @@ absl::StatusOr<CalibrationResult> CalibrateViewpoint(
   r.degeneracy_ratio = DegeneracyRatio(r.icp);
   r.degenerate = r.degeneracy_ratio < s.degeneracy_threshold;
   if (r.degenerate)
-    r.warnings.push_back(absl::StrCat(
-        "degenerate: the gauge scan does not constrain all six degrees of freedom "
-        "(eigenvalue ratio ", r.degeneracy_ratio, " < ", s.degeneracy_threshold,
-        "); rescan so that non-parallel surfaces are in view"));
+    r.warnings.push_back(
+        absl::StrCat("degenerate: the gauge scan does not constrain all six degrees of freedom "
+                     "(eigenvalue ratio ",
+                     r.degeneracy_ratio, " < ", s.degeneracy_threshold,
+                     "); rescan so that non-parallel surfaces are in view"));
   if (!r.icp.converged)
     r.warnings.push_back(absl::StrCat("ICP stopped at max_iterations (", r.icp.iterations, ")"));
 

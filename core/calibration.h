@@ -23,7 +23,7 @@
 namespace surfinspect {
 
 struct CalibrationSettings {
-  bool filter_outliers = true;      // link clustering before ICP (the paper's order)
+  bool filter_outliers = true;  // link clustering before ICP (the paper's order)
   LinkClusteringSettings filter;
   // Point-to-plane by default: on the demo gauge it converges in a few
   // iterations and its covariance matches the observed error (tests). The
@@ -53,19 +53,19 @@ struct CalibrationResult {
   Eigen::Isometry3d world_from_sensor = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d gauge_from_sensor = Eigen::Isometry3d::Identity();
   IcpResult icp;
-  std::size_t scan_points = 0;       // valid points in the scan
-  std::size_t filtered_points = 0;   // removed by link clustering
-  double rms_mm = 0;                 // point-to-plane residual RMS of the inliers
+  std::size_t scan_points = 0;      // valid points in the scan
+  std::size_t filtered_points = 0;  // removed by link clustering
+  double rms_mm = 0;                // point-to-plane residual RMS of the inliers
   double residual_p50_mm = 0, residual_p95_mm = 0, residual_p99_mm = 0;  // of |residual|
-  double inlier_fraction = 0;        // inliers / points used by ICP
+  double inlier_fraction = 0;  // inliers / points used by ICP
   // Covariance of x = [ω (rad), t (mm)], the left perturbation of
   // gauge_from_sensor in the gauge frame: σ² (JᵀJ)⁻¹.
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
-  double sigma_translation_um = 0;   // 1-σ (RMS over x, y, z) of the sensor origin
-  double sigma_rotation_deg = 0;     // 1-σ (RMS over the three axes) of the rotation
-  double degeneracy_ratio = 0;       // see CalibrationSettings::degeneracy_threshold
+  double sigma_translation_um = 0;  // 1-σ (RMS over x, y, z) of the sensor origin
+  double sigma_rotation_deg = 0;    // 1-σ (RMS over the three axes) of the rotation
+  double degeneracy_ratio = 0;      // see CalibrationSettings::degeneracy_threshold
   bool degenerate = false;
-  double coarse_rotation_deg = 0;    // rotation the coarse search applied to the guess
+  double coarse_rotation_deg = 0;  // rotation the coarse search applied to the guess
   std::vector<std::string> warnings;
 };
 

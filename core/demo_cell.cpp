@@ -1,9 +1,8 @@
 #include "core/demo_cell.h"
 
 #include <filesystem>
-#include <random>
-
 #include <nlohmann/json.hpp>
+#include <random>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -23,8 +22,8 @@ using Vec2 = Eigen::Vector2d;  // (y, z) in the pillar's cross-section
 // typical stamped B-pillar reinforcement.
 constexpr double kTopHalfWidth = 30, kHeight = 60, kWallDeg = 75, kFlange = 30, kBendRadius = 6;
 constexpr int kBendSegments = 8;
-constexpr double kStepAlongMm = 5;   // extrusion step
-constexpr double kBowSagMm = 3;      // the ridge sags 3 mm towards the ends
+constexpr double kStepAlongMm = 5;  // extrusion step
+constexpr double kBowSagMm = 3;     // the ridge sags 3 mm towards the ends
 
 // Rounds the corners of a polyline with circular arcs of radius r.
 std::vector<Vec2> FilletPolyline(const std::vector<Vec2>& sharp, double r, int segments) {
@@ -53,7 +52,8 @@ std::vector<Vec2> FilletPolyline(const std::vector<Vec2>& sharp, double r, int s
 void AddBox(TriangleMesh& m, const Eigen::Vector3f& lo, const Eigen::Vector3f& hi) {
   const auto base = static_cast<uint32_t>(m.vertices.size());
   for (int i = 0; i < 8; ++i)
-    m.vertices.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
+    m.vertices.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(),
+                            i & 4 ? hi.z() : lo.z());
   const Triangle faces[12] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
                               {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
   for (const auto& f : faces) m.triangles.push_back({base + f[0], base + f[1], base + f[2]});
@@ -61,7 +61,7 @@ void AddBox(TriangleMesh& m, const Eigen::Vector3f& lo, const Eigen::Vector3f& h
 
 void AddSphere(TriangleMesh& m, const Eigen::Vector3d& c, double r, int slices, int stacks) {
   const auto base = static_cast<uint32_t>(m.vertices.size());
-  m.vertices.push_back((c + Eigen::Vector3d(0, 0, r)).cast<float>());   // north pole
+  m.vertices.push_back((c + Eigen::Vector3d(0, 0, r)).cast<float>());  // north pole
   for (int s = 1; s < stacks; ++s) {
     const double phi = M_PI * s / stacks;
     for (int k = 0; k < slices; ++k) {
@@ -71,7 +71,7 @@ void AddSphere(TriangleMesh& m, const Eigen::Vector3d& c, double r, int slices, 
                                .cast<float>());
     }
   }
-  m.vertices.push_back((c - Eigen::Vector3d(0, 0, r)).cast<float>());   // south pole
+  m.vertices.push_back((c - Eigen::Vector3d(0, 0, r)).cast<float>());  // south pole
   const uint32_t south = static_cast<uint32_t>(m.vertices.size() - 1);
   auto ring = [&](int s, int k) { return base + 1 + uint32_t((s - 1) * slices + (k % slices)); };
   for (int k = 0; k < slices; ++k) m.triangles.push_back({base, ring(1, k), ring(1, k + 1)});
@@ -80,7 +80,8 @@ void AddSphere(TriangleMesh& m, const Eigen::Vector3d& c, double r, int slices, 
       m.triangles.push_back({ring(s, k), ring(s + 1, k), ring(s + 1, k + 1)});
       m.triangles.push_back({ring(s, k), ring(s + 1, k + 1), ring(s, k + 1)});
     }
-  for (int k = 0; k < slices; ++k) m.triangles.push_back({south, ring(stacks - 1, k + 1), ring(stacks - 1, k)});
+  for (int k = 0; k < slices; ++k)
+    m.triangles.push_back({south, ring(stacks - 1, k + 1), ring(stacks - 1, k)});
 }
 
 Eigen::Isometry3d Pose(const Eigen::Vector3d& t, double yaw_deg) {
@@ -106,14 +107,14 @@ double RidgeZ(double x, double length) {
   return kHeight - kBowSagMm * u * u;
 }
 
-
 }  // namespace
 
 TriangleMesh MakePillarMesh(double length_mm) {
   const double run = kHeight / std::tan(kWallDeg * M_PI / 180);
   const double a = kTopHalfWidth;
-  const std::vector<Vec2> sharp = {{-(a + run + kFlange), 0}, {-(a + run), 0}, {-a, kHeight},
-                                   {a, kHeight}, {a + run, 0}, {a + run + kFlange, 0}};
+  const std::vector<Vec2> sharp = {
+      {-(a + run + kFlange), 0}, {-(a + run), 0}, {-a, kHeight}, {a, kHeight}, {a + run, 0},
+      {a + run + kFlange, 0}};
   const std::vector<Vec2> profile = FilletPolyline(sharp, kBendRadius, kBendSegments);
   const int along = std::max(1, static_cast<int>(std::lround(length_mm / kStepAlongMm)));
   const auto np = static_cast<uint32_t>(profile.size());
@@ -158,14 +159,16 @@ DemoCell MakeDemoCell(const DemoCellOptions& o) {
     const double x = xs[v] * o.part_length_mm;
     const Eigen::Vector3d target_part(x, 0, RidgeZ(x, o.part_length_mm));
     const Eigen::Vector3d target = cell.world_from_part * target_part;
-    const Eigen::Vector3d dir = (Eigen::AngleAxisd(tilt_deg[v][0] * M_PI / 180, Eigen::Vector3d::UnitX()) *
-                                 Eigen::AngleAxisd(tilt_deg[v][1] * M_PI / 180, Eigen::Vector3d::UnitY()) *
-                                 Eigen::Vector3d::UnitZ());
+    const Eigen::Vector3d dir =
+        (Eigen::AngleAxisd(tilt_deg[v][0] * M_PI / 180, Eigen::Vector3d::UnitX()) *
+         Eigen::AngleAxisd(tilt_deg[v][1] * M_PI / 180, Eigen::Vector3d::UnitY()) *
+         Eigen::Vector3d::UnitZ());
     DemoViewpoint vp;
     vp.name = absl::StrCat("v", v + 1);
     vp.world_from_sensor = LookAt(target + 400.0 * dir, target,
                                   cell.world_from_part.linear() * -Eigen::Vector3d::UnitY());
-    vp.nominal_world_from_sensor = vp.world_from_sensor * Perturb(rng, o.nominal_error_mm, o.nominal_error_deg);
+    vp.nominal_world_from_sensor =
+        vp.world_from_sensor * Perturb(rng, o.nominal_error_mm, o.nominal_error_deg);
     // The gauge is surveyed where the optical axis meets z = 20 mm.
     const Eigen::Vector3d eye = vp.world_from_sensor.translation();
     const Eigen::Vector3d axis = vp.world_from_sensor.linear().col(2);
@@ -196,12 +199,14 @@ absl::Status WriteDemoCell(const std::string& dir, const DemoCell& cell,
                                    cell.intrinsics, gauge_opt);
     if (!gauge_scan.ok()) return gauge_scan.status();
     const std::string gauge_path = absl::StrCat("gauge_scans/", vp.name, ".pcd");
-    if (auto st = WritePointCloud(dir + "/" + gauge_path, gauge_scan->cloud_in_sensor); !st.ok()) return st;
-    views.push_back({{"name", vp.name},
-                     {"nominal_world_from_sensor", TransformToJsonValue(vp.nominal_world_from_sensor)},
-                     {"world_from_gauge", TransformToJsonValue(vp.world_from_gauge)},
-                     {"gauge_scan", gauge_path},
-                     {"simulation_truth_world_from_sensor", TransformToJsonValue(vp.world_from_sensor)}});
+    if (auto st = WritePointCloud(dir + "/" + gauge_path, gauge_scan->cloud_in_sensor); !st.ok())
+      return st;
+    views.push_back(
+        {{"name", vp.name},
+         {"nominal_world_from_sensor", TransformToJsonValue(vp.nominal_world_from_sensor)},
+         {"world_from_gauge", TransformToJsonValue(vp.world_from_gauge)},
+         {"gauge_scan", gauge_path},
+         {"simulation_truth_world_from_sensor", TransformToJsonValue(vp.world_from_sensor)}});
   }
 
   std::mt19937_64 rng(options.scan.seed + 7);
@@ -220,9 +225,10 @@ absl::Status WriteDemoCell(const std::string& dir, const DemoCell& cell,
       defect.radius_mm = uradius(rng);
       defect.depth_mm = (d == 2 ? -1 : 1) * udepth(rng);  // two dents and a bump
       opt.defects.push_back(defect);
-      defects.push_back({{"center_in_part", {x, defect.center_in_part.y(), defect.center_in_part.z()}},
-                         {"radius_mm", defect.radius_mm},
-                         {"depth_mm", defect.depth_mm}});
+      defects.push_back(
+          {{"center_in_part", {x, defect.center_in_part.y(), defect.center_in_part.z()}},
+           {"radius_mm", defect.radius_mm},
+           {"depth_mm", defect.depth_mm}});
     }
     std::filesystem::create_directories(absl::StrCat(dir, "/scans/", part_id), ec);
     std::filesystem::create_directories(absl::StrCat(dir, "/truth/", part_id), ec);
@@ -230,8 +236,8 @@ absl::Status WriteDemoCell(const std::string& dir, const DemoCell& cell,
     for (std::size_t v = 0; v < cell.viewpoints.size(); ++v) {
       const DemoViewpoint& vp = cell.viewpoints[v];
       opt.seed = options.scan.seed * 7919 + k * 100 + v;
-      auto scan = SimulateScan(cell.part, cell.world_from_part, vp.world_from_sensor,
-                               cell.intrinsics, opt);
+      auto scan =
+          SimulateScan(cell.part, cell.world_from_part, vp.world_from_sensor, cell.intrinsics, opt);
       if (!scan.ok()) return scan.status();
       const std::string path = absl::StrCat(dir, "/scans/", part_id, "/", vp.name, ".pcd");
       if (auto st = WritePointCloud(path, scan->cloud_in_sensor); !st.ok()) return st;
@@ -240,14 +246,12 @@ absl::Status WriteDemoCell(const std::string& dir, const DemoCell& cell,
         if (scan->labels[i] == PixelLabel::kPulse) pulses.push_back(i);
         if (scan->labels[i] == PixelLabel::kStripe) stripes.push_back(i);
       }
-      const nlohmann::json truth = {{"part_id", part_id},
-                                    {"viewpoint", vp.name},
-                                    {"valid_points", scan->hits},
-                                    {"pulse_pixels", pulses},
-                                    {"stripe_pixels", stripes},
-                                    {"defect_pixels", scan->defect_pixels}};
-      if (auto st = WriteStringAtomically(absl::StrCat(dir, "/truth/", part_id, "/", vp.name, ".json"),
-                                          truth.dump());
+      const nlohmann::json truth = {
+          {"part_id", part_id},         {"viewpoint", vp.name},
+          {"valid_points", scan->hits}, {"pulse_pixels", pulses},
+          {"stripe_pixels", stripes},   {"defect_pixels", scan->defect_pixels}};
+      if (auto st = WriteStringAtomically(
+              absl::StrCat(dir, "/truth/", part_id, "/", vp.name, ".json"), truth.dump());
           !st.ok())
         return st;
       scans[vp.name] = absl::StrCat("scans/", part_id, "/", vp.name, ".pcd");
@@ -257,7 +261,8 @@ absl::Status WriteDemoCell(const std::string& dir, const DemoCell& cell,
 
   const nlohmann::json cell_json = {
       {"units", "mm"},
-      {"part", {{"mesh", "part.stl"}, {"world_from_part", TransformToJsonValue(cell.world_from_part)}}},
+      {"part",
+       {{"mesh", "part.stl"}, {"world_from_part", TransformToJsonValue(cell.world_from_part)}}},
       {"gauge", {{"mesh", "gauge.stl"}}},
       {"sensor",
        {{"width", cell.intrinsics.width},
@@ -270,7 +275,8 @@ absl::Status WriteDemoCell(const std::string& dir, const DemoCell& cell,
       // outside (unfiltered speckle at shadow edges) before a part fails.
       {"tolerance_mm", 0.3},
       {"error_map", {{"allowed_fraction_outside", 0.001}, {"max_distance_mm", 5.0}}}};
-  if (auto st = WriteStringAtomically(dir + "/cell.json", cell_json.dump(2) + "\n"); !st.ok()) return st;
+  if (auto st = WriteStringAtomically(dir + "/cell.json", cell_json.dump(2) + "\n"); !st.ok())
+    return st;
   return WriteStringAtomically(dir + "/truth/parts.json", nlohmann::json(parts).dump(2) + "\n");
 }
 

@@ -20,16 +20,16 @@
 namespace surfinspect {
 
 struct DemoViewpoint {
-  std::string name;                       // "v1".."v5"
-  Eigen::Isometry3d world_from_sensor;    // the true (taught, repeatable) pose
+  std::string name;                             // "v1".."v5"
+  Eigen::Isometry3d world_from_sensor;          // the true (taught, repeatable) pose
   Eigen::Isometry3d nominal_world_from_sensor;  // the robot's belief: off by mm/deg
-  Eigen::Isometry3d world_from_gauge;     // where the gauge is surveyed for this view
+  Eigen::Isometry3d world_from_gauge;           // where the gauge is surveyed for this view
 };
 
 struct DemoCell {
-  TriangleMesh part;                   // part frame, mm
+  TriangleMesh part;  // part frame, mm
   Eigen::Isometry3d world_from_part;
-  TriangleMesh gauge;                  // gauge frame, mm
+  TriangleMesh gauge;  // gauge frame, mm
   std::vector<DemoViewpoint> viewpoints;
   SensorIntrinsics intrinsics;
 };

@@ -24,8 +24,8 @@ void EmbreeDevice::OnError(void* self, RTCError code, const char* message) {
   auto* d = static_cast<EmbreeDevice*>(self);
   std::lock_guard<std::mutex> lock(d->mu_);
   if (!d->error_.ok()) return;  // keep the first: later ones are usually fallout
-  const std::string text = absl::StrCat("embree error ", static_cast<int>(code), ": ",
-                                        message ? message : "");
+  const std::string text =
+      absl::StrCat("embree error ", static_cast<int>(code), ": ", message ? message : "");
   d->error_ = code == RTC_ERROR_OUT_OF_MEMORY ? absl::ResourceExhaustedError(text)
                                               : absl::InternalError(text);
 }
@@ -48,9 +48,9 @@ absl::StatusOr<std::unique_ptr<EmbreeTriangleScene>> EmbreeTriangleScene::Build(
   RTCGeometry geom = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
   auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
       geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.vertices.size()));
-  auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
-      geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t),
-      mesh.triangles.size()));
+  auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0,
+                                                            RTC_FORMAT_UINT3, 3 * sizeof(uint32_t),
+                                                            mesh.triangles.size()));
   if (!vb || !ib) {
     rtcReleaseGeometry(geom);
     auto e = s->device_->TakeError();

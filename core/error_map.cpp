@@ -33,7 +33,8 @@ absl::Status CheckSettings(const ErrorMapSettings& s) {
   };
   if (!(s.tolerance_mm > 0) || !std::isfinite(s.tolerance_mm))
     return bad("tolerance_mm must be a positive number", s.tolerance_mm);
-  if (!(s.max_distance_mm > 0)) return bad("max_distance_mm must be > 0 (inf allowed)", s.max_distance_mm);
+  if (!(s.max_distance_mm > 0))
+    return bad("max_distance_mm must be > 0 (inf allowed)", s.max_distance_mm);
   if (!(s.allowed_fraction_outside >= 0 && s.allowed_fraction_outside <= 1))
     return bad("allowed_fraction_outside must be in [0, 1]", s.allowed_fraction_outside);
   if (s.histogram_bins < 1 || s.histogram_bins > 100000)
@@ -90,9 +91,12 @@ void ComputeStats(const ErrorMapSettings& settings, ErrorMapResult& r) {
   const double tol = settings.tolerance_mm;
   Verdict& v = r.verdict;
   for (float d : matched) {
-    if (d > tol) ++v.above;
-    else if (d < -tol) ++v.below;
-    else ++v.within;
+    if (d > tol)
+      ++v.above;
+    else if (d < -tol)
+      ++v.below;
+    else
+      ++v.within;
   }
   if (!matched.empty()) {
     // Two passes in double, in input order: deterministic to the last bit.
@@ -116,7 +120,8 @@ void ComputeStats(const ErrorMapSettings& settings, ErrorMapResult& r) {
   }
   v.pass = r.stats.matched > 0 && v.fraction_outside <= settings.allowed_fraction_outside;
   if (r.stats.matched == 0) {
-    v.reason = absl::StrCat("fail: no point within ", settings.max_distance_mm, " mm of the CAD surface");
+    v.reason =
+        absl::StrCat("fail: no point within ", settings.max_distance_mm, " mm of the CAD surface");
   } else {
     v.reason = absl::StrFormat(
         "%s: %.3f%% of %u matched points outside +-%.4g mm (%u above, %u below; allowed %.3f%%)",
@@ -135,8 +140,10 @@ void ComputeStats(const ErrorMapSettings& settings, ErrorMapResult& r) {
   const double per_mm = settings.histogram_bins / (2 * range);
   for (float d : r.deviation_mm) {
     if (std::isnan(d)) continue;
-    if (d < -range) ++h.below_range;
-    else if (d >= range) ++h.above_range;
+    if (d < -range)
+      ++h.below_range;
+    else if (d >= range)
+      ++h.above_range;
     else
       ++h.counts[std::min(h.counts.size() - 1, static_cast<std::size_t>((d + range) * per_mm))];
   }
@@ -179,26 +186,28 @@ absl::StatusOr<ErrorMapResult> ComputeErrorMap(const MeshIndex& index,
                   !FillUnlessCancelled(r.normal_deviation_mm, n, float{NAN}, cancel)))
       return cancelled;
   } catch (const std::bad_alloc&) {
-    return absl::ResourceExhaustedError(absl::StrCat("error map: cannot allocate for ", n, " points"));
+    return absl::ResourceExhaustedError(
+        absl::StrCat("error map: cannot allocate for ", n, " points"));
   }
   const Eigen::Isometry3d part_from_world = world_from_part.inverse();
   BatchQuerySettings query;
   query.max_distance_mm = settings.max_distance_mm;
   query.threads = settings.threads;
   const auto start = std::chrono::steady_clock::now();
-  auto st = QueryClosestEach(
-      index, cloud_in_world, part_from_world, query, cancel,
-      [&](std::size_t i, const ClosestPoint& c) {
-        if (!c.matched()) return;
-        r.deviation_mm[i] = static_cast<float>(c.signed_distance_mm);
-        r.triangle_id[i] = c.triangle_id;
-        r.closest_point[i] = c.point.cast<float>();
-        if (split) {
-          const Eigen::Vector3d diff = part_from_world * cloud_in_world.points[i].cast<double>() - c.point;
-          r.deviation_xyz_mm[i] = diff.cast<float>();
-          r.normal_deviation_mm[i] = static_cast<float>(diff.dot(c.normal));
-        }
-      });
+  auto st =
+      QueryClosestEach(index, cloud_in_world, part_from_world, query, cancel,
+                       [&](std::size_t i, const ClosestPoint& c) {
+                         if (!c.matched()) return;
+                         r.deviation_mm[i] = static_cast<float>(c.signed_distance_mm);
+                         r.triangle_id[i] = c.triangle_id;
+                         r.closest_point[i] = c.point.cast<float>();
+                         if (split) {
+                           const Eigen::Vector3d diff =
+                               part_from_world * cloud_in_world.points[i].cast<double>() - c.point;
+                           r.deviation_xyz_mm[i] = diff.cast<float>();
+                           r.normal_deviation_mm[i] = static_cast<float>(diff.dot(c.normal));
+                         }
+                       });
   if (!st.ok()) return st;
   r.query_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 

@@ -24,17 +24,17 @@
 namespace surfinspect {
 
 struct ErrorMapSettings {
-  double tolerance_mm = 0.1;      // the +-tol band; > 0
-  double max_distance_mm = 5.0;   // farther points are unmatched (NaN), like CloudCompare's
-                                  // C2M max distance; > 0, inf allowed
+  double tolerance_mm = 0.1;     // the +-tol band; > 0
+  double max_distance_mm = 5.0;  // farther points are unmatched (NaN), like CloudCompare's
+                                 // C2M max distance; > 0, inf allowed
   // Fraction of the matched points allowed outside +-tol for a pass. The
   // default 0 is the strict metrology reading (every measured point within
   // tolerance); raise it to tolerate residual noise that filtering kept.
   double allowed_fraction_outside = 0.0;
-  int histogram_bins = 41;         // odd, so one bin is centred on 0
-  double histogram_range_mm = 0;   // half-width of the histogram and colour scale; 0 = auto
-  bool split_components = false;   // also fill the X/Y/Z and normal components
-  int threads = 0;                 // 0 = all cores
+  int histogram_bins = 41;        // odd, so one bin is centred on 0
+  double histogram_range_mm = 0;  // half-width of the histogram and colour scale; 0 = auto
+  bool split_components = false;  // also fill the X/Y/Z and normal components
+  int threads = 0;                // 0 = all cores
 };
 
 struct ErrorMapStats {
@@ -56,9 +56,9 @@ struct Histogram {
 
 struct Verdict {
   bool pass = false;
-  std::size_t within = 0;  // matched points with |deviation| <= tolerance
-  std::size_t above = 0;   // deviation > +tolerance
-  std::size_t below = 0;   // deviation < -tolerance
+  std::size_t within = 0;         // matched points with |deviation| <= tolerance
+  std::size_t above = 0;          // deviation > +tolerance
+  std::size_t below = 0;          // deviation < -tolerance
   double fraction_within = NAN;   // of matched points
   double fraction_outside = NAN;  // of matched points
   std::string reason;             // one line, for people

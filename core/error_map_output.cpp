@@ -42,7 +42,8 @@ class BufferedFile {
  private:
   static constexpr std::size_t kFlushAt = std::size_t{1} << 20;
   void Flush() {
-    if (f_ && !buf_.empty() && std::fwrite(buf_.data(), 1, buf_.size(), f_) != buf_.size()) ok_ = false;
+    if (f_ && !buf_.empty() && std::fwrite(buf_.data(), 1, buf_.size(), f_) != buf_.size())
+      ok_ = false;
     buf_.clear();
   }
   std::string path_;
@@ -82,10 +83,14 @@ void AppendNumber(std::string& line, float v) {
 
 // JSON has no NaN: a missing number is null in the object itself, not only
 // once dumped, so the server's serialisation sees the same thing.
-nlohmann::json Num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+nlohmann::json Num(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
 
 nlohmann::json Stats(const ComponentStats& c) {
-  return {{"mean_mm", Num(c.mean_mm)}, {"rms_mm", Num(c.rms_mm)}, {"min_mm", Num(c.min_mm)},
+  return {{"mean_mm", Num(c.mean_mm)},
+          {"rms_mm", Num(c.rms_mm)},
+          {"min_mm", Num(c.min_mm)},
           {"max_mm", Num(c.max_mm)}};
 }
 
@@ -178,11 +183,11 @@ nlohmann::json ErrorMapReportJson(const ErrorMapResult& r, const ErrorMapSetting
                  {"valid", s.valid},
                  {"matched", s.matched},
                  {"unmatched_valid", s.valid - s.matched}};
-  j["statistics"] = {{"min_mm", Num(s.min_mm)},       {"max_mm", Num(s.max_mm)},
-                     {"mean_mm", Num(s.mean_mm)},     {"stddev_mm", Num(s.stddev_mm)},
-                     {"rms_mm", Num(s.rms_mm)},       {"p1_mm", Num(s.p1_mm)},
-                     {"p5_mm", Num(s.p5_mm)},         {"p50_mm", Num(s.p50_mm)},
-                     {"p95_mm", Num(s.p95_mm)},       {"p99_mm", Num(s.p99_mm)}};
+  j["statistics"] = {{"min_mm", Num(s.min_mm)},   {"max_mm", Num(s.max_mm)},
+                     {"mean_mm", Num(s.mean_mm)}, {"stddev_mm", Num(s.stddev_mm)},
+                     {"rms_mm", Num(s.rms_mm)},   {"p1_mm", Num(s.p1_mm)},
+                     {"p5_mm", Num(s.p5_mm)},     {"p50_mm", Num(s.p50_mm)},
+                     {"p95_mm", Num(s.p95_mm)},   {"p99_mm", Num(s.p99_mm)}};
   const Verdict& v = r.verdict;
   j["tolerance"] = {{"band_mm", r.tolerance_mm},
                     {"within", v.within},
@@ -194,12 +199,9 @@ nlohmann::json ErrorMapReportJson(const ErrorMapResult& r, const ErrorMapSetting
                     {"verdict", v.pass ? "pass" : "fail"},
                     {"reason", v.reason}};
   const Histogram& h = r.histogram;
-  j["histogram"] = {{"min_mm", h.min_mm},
-                    {"max_mm", h.max_mm},
-                    {"bin_width_mm", h.bin_width_mm()},
-                    {"counts", h.counts},
-                    {"below_range", h.below_range},
-                    {"above_range", h.above_range}};
+  j["histogram"] = {
+      {"min_mm", h.min_mm}, {"max_mm", h.max_mm},           {"bin_width_mm", h.bin_width_mm()},
+      {"counts", h.counts}, {"below_range", h.below_range}, {"above_range", h.above_range}};
   j["color_range_mm"] = r.color_range_mm;
   if (!r.deviation_xyz_mm.empty())
     j["components"] = {{"frame", "part"},

@@ -58,8 +58,8 @@ RgbImage OrthoMap(const PointCloud& pts, const ErrorMapResult& r, int axis, uint
   if (b.empty()) return RgbImage(kMinMapPixels, kMinMapPixels, kWhite);
   const double eu = std::max(b.max[u] - b.min[u], 1e-9), ev = std::max(b.max[v] - b.min[v], 1e-9);
   const double n = static_cast<double>(std::max<std::size_t>(1, pts.CountValid()));
-  const double pixel = std::max({std::max(eu, ev) / max_px, std::sqrt(eu * ev / n),
-                                 std::max(eu, ev) / 4000.0});
+  const double pixel =
+      std::max({std::max(eu, ev) / max_px, std::sqrt(eu * ev / n), std::max(eu, ev) / 4000.0});
   const auto w = static_cast<uint32_t>(eu / pixel) + 1, h = static_cast<uint32_t>(ev / pixel) + 1;
   const uint32_t zoom = std::max<uint32_t>(1, kMinMapPixels / std::max(w, h));
   RgbImage img(w * zoom, h * zoom, kWhite);
@@ -89,23 +89,29 @@ void DrawPanel(RgbImage& img, int x0, const ErrorMapResult& r) {
   const Verdict& v = r.verdict;
   img.DrawText(x0 + 10, 10, v.pass ? "pass" : "fail", v.pass ? Rgb{0, 140, 0} : Rgb{200, 0, 0}, 3);
   const double range = r.color_range_mm;
-  img.DrawText(x0 + 10, 40, absl::StrCat("tol +-", Label(r.tolerance_mm, range).substr(1), " mm"), kBlack, 2);
-  img.DrawText(x0 + 10, 58,
-               absl::StrFormat("in tol %.2f%%", 100 * (std::isnan(v.fraction_within) ? 0 : v.fraction_within)),
+  img.DrawText(x0 + 10, 40, absl::StrCat("tol +-", Label(r.tolerance_mm, range).substr(1), " mm"),
                kBlack, 2);
-  img.DrawText(x0 + 10, 76, absl::StrCat("rms ", Label(r.stats.rms_mm, range).substr(1), " mm"), kBlack, 2);
+  img.DrawText(x0 + 10, 58,
+               absl::StrFormat("in tol %.2f%%",
+                               100 * (std::isnan(v.fraction_within) ? 0 : v.fraction_within)),
+               kBlack, 2);
+  img.DrawText(x0 + 10, 76, absl::StrCat("rms ", Label(r.stats.rms_mm, range).substr(1), " mm"),
+               kBlack, 2);
   img.DrawText(x0 + 10, 94, absl::StrCat("n ", r.stats.matched, "/", r.stats.valid), kBlack, 2);
 
   const int top = 140, bottom = static_cast<int>(img.height) - 30, bar_x = x0 + 14;
   const double span = bottom - top;
-  auto y_of = [&](double d) { return top + static_cast<int>(std::lround((range - d) / (2 * range) * span)); };
+  auto y_of = [&](double d) {
+    return top + static_cast<int>(std::lround((range - d) / (2 * range) * span));
+  };
   img.DrawText(bar_x, top - 26, "mm", kBlack, 2);
   img.FillRect(bar_x, top - 8, 22, 6, Color(r, 2 * range));  // beyond the scale
   img.FillRect(bar_x, bottom + 2, 22, 6, Color(r, -2 * range));
   for (int y = top; y < bottom; ++y)
     img.FillRect(bar_x, y, 22, 1, Color(r, range - (y - top + 0.5) / span * 2 * range));
   std::vector<double> ticks = {range, 0.0, -range};
-  if (r.tolerance_mm < range && y_of(r.tolerance_mm) - y_of(range) > 16 && y_of(0) - y_of(r.tolerance_mm) > 16)
+  if (r.tolerance_mm < range && y_of(r.tolerance_mm) - y_of(range) > 16 &&
+      y_of(0) - y_of(r.tolerance_mm) > 16)
     ticks.insert(ticks.end(), {r.tolerance_mm, -r.tolerance_mm});
   for (double t : ticks) {
     const int y = y_of(t);
@@ -115,7 +121,8 @@ void DrawPanel(RgbImage& img, int x0, const ErrorMapResult& r) {
 
   const Histogram& h = r.histogram;
   const int hist_x = x0 + 130, hist_w = kPanelWidth - 140;
-  const std::size_t peak = h.counts.empty() ? 0 : *std::max_element(h.counts.begin(), h.counts.end());
+  const std::size_t peak =
+      h.counts.empty() ? 0 : *std::max_element(h.counts.begin(), h.counts.end());
   img.FillRect(hist_x - 1, top, 1, bottom - top, kBlack);  // the axis
   for (std::size_t k = 0; k < h.counts.size() && peak > 0; ++k) {
     const double lo = h.min_mm + k * h.bin_width_mm(), hi = lo + h.bin_width_mm();
@@ -137,12 +144,13 @@ int ThinnestAxis(const Bounds3& b) {
 }
 
 absl::StatusOr<RgbImage> RenderErrorMap(const PointCloud& points, const ErrorMapResult& result,
-                                        const Bounds3& mesh_bounds, const ErrorMapPngOptions& options) {
+                                        const Bounds3& mesh_bounds,
+                                        const ErrorMapPngOptions& options) {
   if (result.deviation_mm.size() != points.size())
     return absl::InvalidArgumentError("error map png: result does not belong to these points");
   if (options.view_axis < -1 || options.view_axis > 2)
-    return absl::InvalidArgumentError(absl::StrCat("error map png: view_axis must be -1, 0, 1 or 2, got ",
-                                                   options.view_axis));
+    return absl::InvalidArgumentError(
+        absl::StrCat("error map png: view_axis must be -1, 0, 1 or 2, got ", options.view_axis));
   if (options.max_map_pixels < 16 || options.max_map_pixels > 20000)
     return absl::InvalidArgumentError("error map png: max_map_pixels must be in [16, 20000]");
   if (!(result.color_range_mm > 0))
@@ -151,8 +159,7 @@ absl::StatusOr<RgbImage> RenderErrorMap(const PointCloud& points, const ErrorMap
   const RgbImage map = points.organized() ? GridMap(points, result, options.max_map_pixels)
                                           : OrthoMap(points, result, axis, options.max_map_pixels);
   RgbImage img(map.width + kPanelWidth, std::max<uint32_t>(map.height, kMinHeight), kWhite);
-  for (uint32_t y = 0; y < map.height; ++y)
-    std::copy_n(&map.at(0, y), map.width, &img.at(0, y));
+  for (uint32_t y = 0; y < map.height; ++y) std::copy_n(&map.at(0, y), map.width, &img.at(0, y));
   DrawPanel(img, static_cast<int>(map.width), result);
   return img;
 }

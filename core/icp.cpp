@@ -22,7 +22,8 @@ absl::Status CheckSettings(const IcpSettings& s) {
         "icp: need 0 < min_correspondence_mm <= max_correspondence_mm < inf");
   if (!(s.trim_fraction >= 0 && s.trim_fraction < 0.9))
     return absl::InvalidArgumentError("icp: trim_fraction must be in [0, 0.9)");
-  if (!(s.kernel_scale_mm > 0)) return absl::InvalidArgumentError("icp: kernel_scale_mm must be > 0");
+  if (!(s.kernel_scale_mm > 0))
+    return absl::InvalidArgumentError("icp: kernel_scale_mm must be > 0");
   if (!(s.relative_cost_tolerance >= 0) || !(s.absolute_cost_mm2 >= 0))
     return absl::InvalidArgumentError("icp: tolerances must be >= 0");
   return absl::OkStatus();
@@ -31,8 +32,10 @@ absl::Status CheckSettings(const IcpSettings& s) {
 double KernelWeight(const IcpSettings& s, double r) {
   const double a = std::abs(r);
   switch (s.kernel) {
-    case RobustKernel::kNone: return 1.0;
-    case RobustKernel::kHuber: return a <= s.kernel_scale_mm ? 1.0 : s.kernel_scale_mm / a;
+    case RobustKernel::kNone:
+      return 1.0;
+    case RobustKernel::kHuber:
+      return a <= s.kernel_scale_mm ? 1.0 : s.kernel_scale_mm / a;
     case RobustKernel::kTukey: {
       if (a >= s.kernel_scale_mm) return 0.0;
       const double u = 1.0 - (a / s.kernel_scale_mm) * (a / s.kernel_scale_mm);
@@ -70,8 +73,8 @@ struct Pairs {
 
 // Pairs within the gate (and the trim), with weights, at the given pose.
 absl::StatusOr<Pairs> Correspond(const MeshIndex& mesh, const PointCloud& pts,
-                                 const Eigen::Isometry3d& pose, double gate,
-                                 const IcpSettings& s, const std::atomic<bool>* cancel) {
+                                 const Eigen::Isometry3d& pose, double gate, const IcpSettings& s,
+                                 const std::atomic<bool>* cancel) {
   BatchQuerySettings q;
   q.max_distance_mm = gate;
   q.threads = s.threads;
@@ -83,7 +86,8 @@ absl::StatusOr<Pairs> Correspond(const MeshIndex& mesh, const PointCloud& pts,
     if (c.matched()) dist.push_back(c.distance_mm);
   double trim_at = INFINITY;
   if (s.trim_fraction > 0 && !dist.empty()) {
-    const std::size_t k = std::min(dist.size() - 1, std::size_t((1.0 - s.trim_fraction) * dist.size()));
+    const std::size_t k =
+        std::min(dist.size() - 1, std::size_t((1.0 - s.trim_fraction) * dist.size()));
     std::nth_element(dist.begin(), dist.begin() + k, dist.end());
     trim_at = dist[k];
   }
@@ -96,7 +100,8 @@ absl::StatusOr<Pairs> Correspond(const MeshIndex& mesh, const PointCloud& pts,
     // Inside a face the plane normal; at an edge or vertex the direction to
     // the point, which is the normal of the distance field there.
     Eigen::Vector3d n = c.normal;
-    if (c.feature != ClosestFeature::kFace && c.distance_mm > 1e-9) n = (p - c.point) / c.distance_mm;
+    if (c.feature != ClosestFeature::kFace && c.distance_mm > 1e-9)
+      n = (p - c.point) / c.distance_mm;
     if (n.squaredNorm() < 0.5) continue;  // degenerate triangle, no usable normal
     const double r = s.step == IcpStep::kPointToPlane ? (p - c.point).dot(n) : c.distance_mm;
     out.p.push_back(p);
@@ -132,7 +137,8 @@ absl::StatusOr<Eigen::Isometry3d> Step(const Pairs& pr, const IcpSettings& s) {
   if (ldlt.info() != Eigen::Success || !ldlt.isPositive())
     return absl::FailedPreconditionError("icp: point-to-plane system is singular");
   const Eigen::Matrix<double, 6, 1> x = ldlt.solve(-b);
-  if (!x.allFinite()) return absl::FailedPreconditionError("icp: point-to-plane step is not finite");
+  if (!x.allFinite())
+    return absl::FailedPreconditionError("icp: point-to-plane step is not finite");
   Eigen::Isometry3d d = Eigen::Isometry3d::Identity();
   const Eigen::Vector3d w = x.head<3>();
   if (w.norm() > 0) d.linear() = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
@@ -144,9 +150,12 @@ absl::StatusOr<Eigen::Isometry3d> Step(const Pairs& pr, const IcpSettings& s) {
 
 const char* ToString(IcpStopReason reason) {
   switch (reason) {
-    case IcpStopReason::kRelativeChange: return "relative_change";
-    case IcpStopReason::kAbsoluteCost: return "absolute_cost";
-    case IcpStopReason::kMaxIterations: return "max_iterations";
+    case IcpStopReason::kRelativeChange:
+      return "relative_change";
+    case IcpStopReason::kAbsoluteCost:
+      return "absolute_cost";
+    case IcpStopReason::kMaxIterations:
+      return "max_iterations";
   }
   return "unknown";
 }
@@ -156,7 +165,8 @@ absl::StatusOr<IcpResult> RunIcp(const MeshIndex& mesh, const PointCloud& points
                                  const std::atomic<bool>* cancel) {
   if (auto st = CheckSettings(s); !st.ok()) return st;
   if (auto st = points.Validate(); !st.ok()) return st;
-  if (!initial.matrix().allFinite()) return absl::InvalidArgumentError("icp: initial pose is not finite");
+  if (!initial.matrix().allFinite())
+    return absl::InvalidArgumentError("icp: initial pose is not finite");
   const PointCloud pts = Subsample(points, s.max_points, s.seed);
   if (pts.size() < 6) return absl::InvalidArgumentError("icp: fewer than 6 valid points");
 
@@ -169,9 +179,9 @@ absl::StatusOr<IcpResult> RunIcp(const MeshIndex& mesh, const PointCloud& points
     auto pairs = Correspond(mesh, pts, pose, gate, s, cancel);
     if (!pairs.ok()) return pairs.status();
     if (pairs->p.size() < 6)
-      return absl::FailedPreconditionError(absl::StrCat(
-          "icp: only ", pairs->p.size(), " of ", pts.size(), " points within ", gate,
-          " mm of the mesh at iteration ", it, "; is the initial pose too far off?"));
+      return absl::FailedPreconditionError(
+          absl::StrCat("icp: only ", pairs->p.size(), " of ", pts.size(), " points within ", gate,
+                       " mm of the mesh at iteration ", it, "; is the initial pose too far off?"));
     const std::vector<double>& h = result.cost_history;
     result.cost_history.push_back(pairs->cost);
     result.mesh_from_points = pose;
@@ -184,7 +194,8 @@ absl::StatusOr<IcpResult> RunIcp(const MeshIndex& mesh, const PointCloud& points
       stop = true;
     } else if (it >= 1) {
       const double dec1 = h[it - 1] - h[it];
-      const double delta = it >= 2 && h[it - 2] - h[it - 1] > 0 ? dec1 / (h[it - 2] - h[it - 1]) : -1;
+      const double delta =
+          it >= 2 && h[it - 2] - h[it - 1] > 0 ? dec1 / (h[it - 2] - h[it - 1]) : -1;
       const bool rate_usable = delta >= 0 && delta < 1;
       const double remaining = rate_usable ? dec1 * delta / (1 - delta) : std::abs(dec1);
       // A step that no longer lowers the cost (with the gate unchanged, so

@@ -43,32 +43,32 @@ struct IcpSettings {
   // follows 4 x the previous RMS, never below `min_correspondence_mm`.
   double max_correspondence_mm = 50.0;
   double min_correspondence_mm = 2.0;
-  double trim_fraction = 0.0;          // also drop this worst fraction of pairs
+  double trim_fraction = 0.0;  // also drop this worst fraction of pairs
   RobustKernel kernel = RobustKernel::kNone;
-  double kernel_scale_mm = 0.05;       // Huber threshold / Tukey cut-off
+  double kernel_scale_mm = 0.05;          // Huber threshold / Tukey cut-off
   double relative_cost_tolerance = 1e-4;  // remaining gain / cost (eq. (5) extrapolated)
-  double absolute_cost_mm2 = 0.0;      // stop when the mean squared distance is below
-  std::size_t max_points = 40000;      // random subsample (fixed seed); 0 = all points
+  double absolute_cost_mm2 = 0.0;         // stop when the mean squared distance is below
+  std::size_t max_points = 40000;         // random subsample (fixed seed); 0 = all points
   uint64_t seed = 1;
-  int threads = 0;                     // 0 = all cores; results do not depend on it
+  int threads = 0;  // 0 = all cores; results do not depend on it
 };
 
 struct IcpResult {
   Eigen::Isometry3d mesh_from_points = Eigen::Isometry3d::Identity();
-  bool converged = false;              // stopped by a cost criterion, not max_iterations
+  bool converged = false;  // stopped by a cost criterion, not max_iterations
   IcpStopReason stop_reason = IcpStopReason::kMaxIterations;
   int iterations = 0;
-  double rms_mm = 0;                   // of the inlier pairs at the final pose
-  std::size_t points_used = 0;         // after subsampling
-  std::size_t inliers = 0;             // pairs within the final gate
-  std::vector<double> cost_history;    // Δ_i: mean squared distance per iteration, mm²
+  double rms_mm = 0;                 // of the inlier pairs at the final pose
+  std::size_t points_used = 0;       // after subsampling
+  std::size_t inliers = 0;           // pairs within the final gate
+  std::vector<double> cost_history;  // Δ_i: mean squared distance per iteration, mm²
   // Final point-to-plane normal matrix J^T W J over the inliers, for the
   // pose perturbation x = [ω (rad), t (mm)] applied on the left in the mesh
   // frame (exp(x) * mesh_from_points). Used for covariance and degeneracy.
   Eigen::Matrix<double, 6, 6> normal_matrix = Eigen::Matrix<double, 6, 6>::Zero();
-  std::vector<double> residuals_mm;    // signed point-to-plane residuals of the inliers
+  std::vector<double> residuals_mm;  // signed point-to-plane residuals of the inliers
   Eigen::Vector3d inlier_centroid = Eigen::Vector3d::Zero();  // mesh frame, mm
-  double inlier_radius_mm = 0;         // RMS distance of the inliers from their centroid
+  double inlier_radius_mm = 0;  // RMS distance of the inliers from their centroid
 };
 
 // Fails with InvalidArgument for bad settings or fewer than 6 valid points,

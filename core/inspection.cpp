@@ -1,8 +1,8 @@
 #include "core/inspection.h"
 
-#include "absl/strings/str_cat.h"
 #include <nlohmann/json.hpp>
 
+#include "absl/strings/str_cat.h"
 #include "core/cancel.h"
 #include "core/error_map_output.h"
 #include "core/error_map_png.h"
@@ -42,7 +42,8 @@ absl::StatusOr<InspectionResult> InspectPart(const MeshIndex& part,
     for (std::size_t k = 0; k < views.size(); ++k)
       progress(InspectionStage::kViewRegistered, views[k].name, out.merged.points_per_view[k]);
   if (IsCancelled(cancel)) return absl::CancelledError("inspect cancelled");
-  auto map = ComputeErrorMap(part, out.merged.cloud_in_world, world_from_part, settings.error_map, cancel);
+  auto map =
+      ComputeErrorMap(part, out.merged.cloud_in_world, world_from_part, settings.error_map, cancel);
   if (!map.ok()) return map.status();
   out.error_map = *std::move(map);
   if (progress) progress(InspectionStage::kErrorMap, "", out.error_map.stats.matched);

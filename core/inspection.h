@@ -20,7 +20,7 @@
 namespace surfinspect {
 
 struct InspectionSettings {
-  bool filter = true;                  // link-clustering filter per view
+  bool filter = true;  // link-clustering filter per view
   // The inspection preset, not the paper's 0.5 mm: before an error map no
   // dent point may be lost, and at 0.5 mm steep walls break into small
   // strips that the size criterion removes (link_clustering.h).
@@ -32,13 +32,13 @@ enum class InspectionStage { kViewFiltered, kViewRegistered, kErrorMap };
 
 struct ViewOutcome {
   std::string name;
-  std::size_t valid_points = 0;     // before filtering
-  std::size_t removed_points = 0;   // by the filter
+  std::size_t valid_points = 0;    // before filtering
+  std::size_t removed_points = 0;  // by the filter
 };
 
 struct InspectionResult {
-  MergedCloud merged;                // world frame; traces back to view + pixel
-  ErrorMapResult error_map;          // per merged point
+  MergedCloud merged;        // world frame; traces back to view + pixel
+  ErrorMapResult error_map;  // per merged point
   std::vector<ViewOutcome> views;
 };
 

@@ -1,11 +1,11 @@
 #include "core/io_mesh.h"
 
-#include <assimp/Exporter.hpp>
-#include <assimp/Importer.hpp>
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <assimp/Exporter.hpp>
+#include <assimp/Importer.hpp>
 #include <fstream>
 
 #include "absl/strings/ascii.h"
@@ -32,23 +32,21 @@ absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path, const MeshReadLim
   const auto size = static_cast<uint64_t>(probe.tellg());
   if (size == 0) return Bad(path, "file is empty");
   if (size > limits.max_file_bytes)
-    return absl::ResourceExhaustedError(absl::StrCat(path, ": file exceeds ",
-                                                     limits.max_file_bytes, " bytes"));
+    return absl::ResourceExhaustedError(
+        absl::StrCat(path, ": file exceeds ", limits.max_file_bytes, " bytes"));
   Assimp::Importer importer;
   // Drop normals/UVs/colours first so JoinIdenticalVertices merges by
   // position alone (STL stores a face normal with every corner).
-  importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS,
-                              aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
-                                  aiComponent_COLORS | aiComponent_TEXCOORDS |
-                                  aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS |
-                                  aiComponent_TEXTURES | aiComponent_LIGHTS |
-                                  aiComponent_CAMERAS | aiComponent_MATERIALS);
+  importer.SetPropertyInteger(
+      AI_CONFIG_PP_RVC_FLAGS,
+      aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS | aiComponent_COLORS |
+          aiComponent_TEXCOORDS | aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS |
+          aiComponent_TEXTURES | aiComponent_LIGHTS | aiComponent_CAMERAS | aiComponent_MATERIALS);
   const aiScene* scene = nullptr;
   try {
-    scene = importer.ReadFile(path, aiProcess_RemoveComponent | aiProcess_Triangulate |
-                                        aiProcess_JoinIdenticalVertices |
-                                        aiProcess_PreTransformVertices |
-                                        aiProcess_ValidateDataStructure);
+    scene = importer.ReadFile(
+        path, aiProcess_RemoveComponent | aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                  aiProcess_PreTransformVertices | aiProcess_ValidateDataStructure);
   } catch (const std::exception& e) {
     return Bad(path, absl::StrCat("importer error: ", e.what()));
   }
@@ -57,9 +55,8 @@ absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path, const MeshReadLim
   uint64_t tri_total = 0;
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) tri_total += scene->mMeshes[m]->mNumFaces;
   if (tri_total > limits.max_triangles)
-    return absl::ResourceExhaustedError(absl::StrCat(path, ": ", tri_total,
-                                                     " faces exceed the limit of ",
-                                                     limits.max_triangles));
+    return absl::ResourceExhaustedError(
+        absl::StrCat(path, ": ", tri_total, " faces exceed the limit of ", limits.max_triangles));
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
     const aiMesh* am = scene->mMeshes[m];
     const auto base = static_cast<uint32_t>(mesh.vertices.size());
@@ -91,10 +88,10 @@ absl::Status WriteMesh(const std::string& path, const TriangleMesh& mesh, MeshFo
   scene.mRootNode = new aiNode();
   scene.mRootNode->mMeshes = new unsigned[1]{0};
   scene.mRootNode->mNumMeshes = 1;
-  scene.mMaterials = new aiMaterial*[1]{new aiMaterial()};
+  scene.mMaterials = new aiMaterial* [1] { new aiMaterial() };
   scene.mNumMaterials = 1;
   auto* am = new aiMesh();
-  scene.mMeshes = new aiMesh*[1]{am};
+  scene.mMeshes = new aiMesh* [1] { am };
   scene.mNumMeshes = 1;
   am->mMaterialIndex = 0;
   am->mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
@@ -106,16 +103,26 @@ absl::Status WriteMesh(const std::string& path, const TriangleMesh& mesh, MeshFo
   am->mFaces = new aiFace[am->mNumFaces];
   for (unsigned f = 0; f < am->mNumFaces; ++f) {
     am->mFaces[f].mNumIndices = 3;
-    am->mFaces[f].mIndices = new unsigned[3]{mesh.triangles[f][0], mesh.triangles[f][1],
-                                             mesh.triangles[f][2]};
+    am->mFaces[f].mIndices =
+        new unsigned[3]{mesh.triangles[f][0], mesh.triangles[f][1], mesh.triangles[f][2]};
   }
   const char* id = "stlb";
   switch (format) {
-    case MeshFormat::kStlBinary: id = "stlb"; break;
-    case MeshFormat::kStlAscii: id = "stl"; break;
-    case MeshFormat::kObj: id = "objnomtl"; break;
-    case MeshFormat::kPlyBinary: id = "plyb"; break;
-    case MeshFormat::kPlyAscii: id = "ply"; break;
+    case MeshFormat::kStlBinary:
+      id = "stlb";
+      break;
+    case MeshFormat::kStlAscii:
+      id = "stl";
+      break;
+    case MeshFormat::kObj:
+      id = "objnomtl";
+      break;
+    case MeshFormat::kPlyBinary:
+      id = "plyb";
+      break;
+    case MeshFormat::kPlyAscii:
+      id = "ply";
+      break;
   }
   return WriteFileAtomically(path, [&](const std::string& tmp) -> absl::Status {
     Assimp::Exporter exporter;

@@ -19,8 +19,7 @@ struct MeshReadLimits {
 
 // Fails with a message naming the file for: unreadable or truncated files,
 // no triangles, non-finite vertices, only degenerate triangles, limits.
-absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path,
-                                      const MeshReadLimits& limits = {});
+absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path, const MeshReadLimits& limits = {});
 
 enum class MeshFormat { kStlBinary, kStlAscii, kObj, kPlyBinary, kPlyAscii };
 

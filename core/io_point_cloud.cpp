@@ -92,8 +92,8 @@ absl::Status CheckPcdHeader(const std::string& path, const CloudReadLimits& limi
   const auto& fields = kv["FIELDS"];
   const auto& sizes = kv["SIZE"];
   const auto& types = kv["TYPE"];
-  std::vector<std::string> counts = kv.count("COUNT") ? kv["COUNT"]
-                                                      : std::vector<std::string>(fields.size(), "1");
+  std::vector<std::string> counts =
+      kv.count("COUNT") ? kv["COUNT"] : std::vector<std::string>(fields.size(), "1");
   if (sizes.size() != fields.size() || types.size() != fields.size() ||
       counts.size() != fields.size())
     return Bad(path, "PCD header: FIELDS, SIZE, TYPE and COUNT disagree in length");
@@ -121,8 +121,8 @@ absl::Status CheckPcdHeader(const std::string& path, const CloudReadLimits& limi
     return Bad(path, absl::StrCat("PCD header: WIDTH*HEIGHT (", width, "*", height,
                                   ") does not equal POINTS (", points, ")"));
   if (points > limits.max_points)
-    return absl::ResourceExhaustedError(absl::StrCat(
-        path, ": ", points, " points exceed the limit of ", limits.max_points));
+    return absl::ResourceExhaustedError(
+        absl::StrCat(path, ": ", points, " points exceed the limit of ", limits.max_points));
   const std::string data = kv["DATA"].empty() ? "" : Lower(kv["DATA"][0]);
   const uint64_t file_size = FileSize(path);
   if (data == "binary") {
@@ -154,10 +154,9 @@ absl::Status CheckPcdHeader(const std::string& path, const CloudReadLimits& limi
 
 int PlyTypeSize(const std::string& t) {
   static const std::map<std::string, int> sizes = {
-      {"char", 1},  {"int8", 1},   {"uchar", 1},  {"uint8", 1},   {"short", 2},
-      {"int16", 2}, {"ushort", 2}, {"uint16", 2}, {"int", 4},     {"int32", 4},
-      {"uint", 4},  {"uint32", 4}, {"float", 4},  {"float32", 4}, {"double", 8},
-      {"float64", 8}};
+      {"char", 1},   {"int8", 1},    {"uchar", 1},  {"uint8", 1},  {"short", 2}, {"int16", 2},
+      {"ushort", 2}, {"uint16", 2},  {"int", 4},    {"int32", 4},  {"uint", 4},  {"uint32", 4},
+      {"float", 4},  {"float32", 4}, {"double", 8}, {"float64", 8}};
   auto it = sizes.find(t);
   return it == sizes.end() ? 0 : it->second;
 }
@@ -210,9 +209,9 @@ absl::Status CheckPlyHeader(const std::string& path, const CloudReadLimits& limi
   uint64_t min_bytes = 0, total_rows = 0;
   for (const auto& e : elements) {
     if (e.count > limits.max_points)
-      return absl::ResourceExhaustedError(absl::StrCat(
-          path, ": element ", e.name, " declares ", e.count, " rows, over the limit of ",
-          limits.max_points));
+      return absl::ResourceExhaustedError(absl::StrCat(path, ": element ", e.name, " declares ",
+                                                       e.count, " rows, over the limit of ",
+                                                       limits.max_points));
     min_bytes += e.count * e.min_row_bytes;
     total_rows += e.count;
     if (e.name == "vertex") vertex = &e;
@@ -225,8 +224,8 @@ absl::Status CheckPlyHeader(const std::string& path, const CloudReadLimits& limi
   if (format == "ascii") {
     const uint64_t lines_found = CountDataLines(path, data_offset, total_rows);
     if (lines_found < total_rows)
-      return Bad(path, absl::StrCat("truncated: ", total_rows, " rows declared, ", lines_found,
-                                    " found"));
+      return Bad(
+          path, absl::StrCat("truncated: ", total_rows, " rows declared, ", lines_found, " found"));
   } else if (file_size < data_offset + min_bytes) {
     return Bad(path, absl::StrCat("truncated: declared elements need at least ", min_bytes,
                                   " data bytes, file has ", file_size - data_offset));
@@ -264,8 +263,8 @@ absl::StatusOr<PointCloud> FromBlob(const std::string& path, const pcl::PCLPoint
   cloud.points.resize(n);
   for (uint32_t r = 0; r < blob.height; ++r)
     for (uint32_t c = 0; c < blob.width; ++c) {
-      const uint8_t* rec = blob.data.data() + uint64_t{r} * blob.row_step +
-                           uint64_t{c} * blob.point_step;
+      const uint8_t* rec =
+          blob.data.data() + uint64_t{r} * blob.row_step + uint64_t{c} * blob.point_step;
       Eigen::Vector3f& p = cloud.points[uint64_t{r} * blob.width + c];
       for (int a = 0; a < 3; ++a) {
         if (types[a] == pcl::PCLPointField::FLOAT32) {
@@ -347,8 +346,7 @@ void QuietPcl() {
 
 }  // namespace
 
-absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path,
-                                          const CloudReadLimits& limits) {
+absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path, const CloudReadLimits& limits) {
   QuietPcl();
   const std::string ext = Extension(path);
   if (ext != "pcd" && ext != "ply")
@@ -395,9 +393,16 @@ absl::Status WritePointCloud(const std::string& path, const PointCloud& cloud,
       if (ext == "pcd") {
         pcl::PCDWriter w;
         switch (pcd_encoding) {
-          case PcdEncoding::kAscii: rc = w.writeASCII(tmp, blob, Eigen::Vector4f::Zero(), Eigen::Quaternionf::Identity(), 9); break;
-          case PcdEncoding::kBinary: rc = w.writeBinary(tmp, blob); break;
-          case PcdEncoding::kBinaryCompressed: rc = w.writeBinaryCompressed(tmp, blob); break;
+          case PcdEncoding::kAscii:
+            rc =
+                w.writeASCII(tmp, blob, Eigen::Vector4f::Zero(), Eigen::Quaternionf::Identity(), 9);
+            break;
+          case PcdEncoding::kBinary:
+            rc = w.writeBinary(tmp, blob);
+            break;
+          case PcdEncoding::kBinaryCompressed:
+            rc = w.writeBinaryCompressed(tmp, blob);
+            break;
         }
       } else if (ply_binary) {
         pcl::PLYWriter w;

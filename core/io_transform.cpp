@@ -45,8 +45,7 @@ absl::StatusOr<Eigen::Isometry3d> ReadTransformJson(const std::string& path) {
 nlohmann::json TransformToJsonValue(const Eigen::Isometry3d& t) {
   const RowMajor16 v = ToRowMajor(t);
   nlohmann::json rows = nlohmann::json::array();
-  for (int r = 0; r < 4; ++r)
-    rows.push_back({v[r * 4], v[r * 4 + 1], v[r * 4 + 2], v[r * 4 + 3]});
+  for (int r = 0; r < 4; ++r) rows.push_back({v[r * 4], v[r * 4 + 1], v[r * 4 + 2], v[r * 4 + 3]});
   return {{"matrix", rows}};
 }
 

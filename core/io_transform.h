@@ -17,7 +17,7 @@ absl::StatusOr<Eigen::Isometry3d> ParseTransformJson(const std::string& text,
 absl::StatusOr<Eigen::Isometry3d> TransformFromJsonValue(const nlohmann::json& j,
                                                          const std::string& what);
 nlohmann::json TransformToJsonValue(const Eigen::Isometry3d& t);  // {"matrix": [[...]]}
-std::string TransformToJson(const Eigen::Isometry3d& t);  // pretty, full precision
+std::string TransformToJson(const Eigen::Isometry3d& t);          // pretty, full precision
 absl::Status WriteTransformJson(const std::string& path, const Eigen::Isometry3d& t);
 
 }  // namespace surfinspect

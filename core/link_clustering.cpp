@@ -18,18 +18,17 @@ constexpr int32_t kInvalid = LinkClusteringResult::kInvalid;
 absl::Status ValidateLinkClusteringSettings(const LinkClusteringSettings& s) {
   if (!(std::isfinite(s.link_distance_mm) && s.link_distance_mm > 0.0))
     return absl::InvalidArgumentError(absl::StrCat(
-        "link clustering: link_distance_mm must be finite and > 0, got ",
-        s.link_distance_mm));
+        "link clustering: link_distance_mm must be finite and > 0, got ", s.link_distance_mm));
   if (s.link_distance_mm > 1e6)
     return absl::InvalidArgumentError(absl::StrCat(
         "link clustering: link_distance_mm = ", s.link_distance_mm, " is absurd (> 1 km)"));
   if (s.connectivity != 4 && s.connectivity != 8)
-    return absl::InvalidArgumentError(absl::StrCat(
-        "link clustering: connectivity must be 4 or 8, got ", s.connectivity));
+    return absl::InvalidArgumentError(
+        absl::StrCat("link clustering: connectivity must be 4 or 8, got ", s.connectivity));
   if (!(s.min_fraction_of_largest >= 0.0 && s.min_fraction_of_largest <= 1.0))
-    return absl::InvalidArgumentError(absl::StrCat(
-        "link clustering: min_fraction_of_largest must be in [0, 1], got ",
-        s.min_fraction_of_largest));
+    return absl::InvalidArgumentError(
+        absl::StrCat("link clustering: min_fraction_of_largest must be in [0, 1], got ",
+                     s.min_fraction_of_largest));
   return absl::OkStatus();
 }
 
@@ -39,16 +38,15 @@ absl::Status CheckInput(const PointCloud& cloud, const LinkClusteringSettings& s
   if (auto st = ValidateLinkClusteringSettings(settings); !st.ok()) return st;
   if (cloud.empty() || cloud.width == 0 || cloud.height == 0)
     return absl::InvalidArgumentError(absl::StrCat(
-        "link clustering: the cloud has no points (grid ", cloud.width, " x ",
-        cloud.height, ")"));
+        "link clustering: the cloud has no points (grid ", cloud.width, " x ", cloud.height, ")"));
   if (std::size_t{cloud.width} * cloud.height != cloud.size())
-    return absl::InvalidArgumentError(
-        absl::StrCat("link clustering: width*height = ", cloud.width, "*", cloud.height,
-                     " does not match ", cloud.size(), " points"));
+    return absl::InvalidArgumentError(absl::StrCat("link clustering: width*height = ", cloud.width,
+                                                   "*", cloud.height, " does not match ",
+                                                   cloud.size(), " points"));
   // Labels are int32 pixel indices during pass 1.
   if (cloud.size() > static_cast<std::size_t>(std::numeric_limits<int32_t>::max()))
-    return absl::InvalidArgumentError(absl::StrCat(
-        "link clustering: ", cloud.size(), " points exceed the 2^31 - 1 limit"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("link clustering: ", cloud.size(), " points exceed the 2^31 - 1 limit"));
   return absl::OkStatus();
 }
 
@@ -60,8 +58,7 @@ void DecideClusters(const LinkClusteringSettings& settings, LinkClusteringResult
   const double by_fraction = settings.min_fraction_of_largest * largest;
   std::size_t kept = 0, valid = 0;
   for (ClusterInfo& k : result.clusters) {
-    k.kept = k.size >= settings.min_cluster_points &&
-             static_cast<double>(k.size) >= by_fraction;
+    k.kept = k.size >= settings.min_cluster_points && static_cast<double>(k.size) >= by_fraction;
     valid += k.size;
     if (k.kept) kept += k.size;
   }
@@ -76,15 +73,13 @@ void FillKeptMaskFromLabels(LinkClusteringResult& result) {
   uint8_t* __restrict mask = result.kept_mask.data();
   const int32_t* __restrict labels = result.labels.data();
   const ClusterInfo* clusters = result.clusters.data();
-  for (std::size_t i = 0; i < n; ++i)
-    mask[i] = labels[i] != kInvalid && clusters[labels[i]].kept;
+  for (std::size_t i = 0; i < n; ++i) mask[i] = labels[i] != kInvalid && clusters[labels[i]].kept;
 }
 
 }  // namespace internal
 
 absl::Status ClusterLinksInto(const PointCloud& cloud, const LinkClusteringSettings& settings,
-                              LinkClusteringResult& result,
-                              const std::atomic<bool>* cancel) {
+                              LinkClusteringResult& result, const std::atomic<bool>* cancel) {
   if (cloud.organized()) return ClusterLinksOrganized(cloud, settings, result, cancel);
   return ClusterLinksUnorganized(cloud, settings, result, cancel);
 }
@@ -100,9 +95,9 @@ absl::StatusOr<LinkClusteringResult> ClusterLinks(const PointCloud& cloud,
 absl::StatusOr<PointCloud> ApplyFilter(const PointCloud& cloud,
                                        const LinkClusteringResult& result) {
   if (result.kept_mask.size() != cloud.size() || result.labels.size() != cloud.size())
-    return absl::InvalidArgumentError(absl::StrCat(
-        "apply filter: the result covers ", result.labels.size(),
-        " points but the cloud has ", cloud.size()));
+    return absl::InvalidArgumentError(absl::StrCat("apply filter: the result covers ",
+                                                   result.labels.size(),
+                                                   " points but the cloud has ", cloud.size()));
   PointCloud out = cloud;
   const Eigen::Vector3f nan = Eigen::Vector3f::Constant(NAN);
   // Only removed points change; no-data pixels keep their exact bits too.

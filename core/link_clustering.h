@@ -83,9 +83,9 @@ struct LinkClusteringResult {
   std::size_t input_points = 0;    // width * height
   std::size_t valid_points = 0;
   std::size_t kept = 0;
-  std::size_t removed = 0;         // valid points in outlier components
-  uint32_t largest_cluster = 0;    // size of the largest component (0 if none)
-  bool organized_path = false;     // which path produced this
+  std::size_t removed = 0;       // valid points in outlier components
+  uint32_t largest_cluster = 0;  // size of the largest component (0 if none)
+  bool organized_path = false;   // which path produced this
 };
 
 // The link predicate both paths (and their tests) use, in float arithmetic
@@ -109,22 +109,20 @@ absl::Status ValidateLinkClusteringSettings(const LinkClusteringSettings& settin
 // Fails with InvalidArgument on bad settings, an empty cloud, a size that
 // does not match width * height, or an infinite coordinate; Cancelled when
 // `cancel` becomes true (checked once per grid row / batch of points).
-absl::StatusOr<LinkClusteringResult> ClusterLinks(
-    const PointCloud& cloud, const LinkClusteringSettings& settings,
-    const std::atomic<bool>* cancel = nullptr);
+absl::StatusOr<LinkClusteringResult> ClusterLinks(const PointCloud& cloud,
+                                                  const LinkClusteringSettings& settings,
+                                                  const std::atomic<bool>* cancel = nullptr);
 
 // The same, reusing `result`'s buffers (no page faults on the steady state
 // of a scan stream). On error `result` holds unspecified contents.
-absl::Status ClusterLinksInto(const PointCloud& cloud,
-                              const LinkClusteringSettings& settings,
+absl::Status ClusterLinksInto(const PointCloud& cloud, const LinkClusteringSettings& settings,
                               LinkClusteringResult& result,
                               const std::atomic<bool>* cancel = nullptr);
 
 // The same cloud with every removed point set to NaN: an organized grid
 // stays the same grid, and kept (and no-data) points are copied bit for bit.
 // InvalidArgument when `result` does not cover this cloud (size mismatch).
-absl::StatusOr<PointCloud> ApplyFilter(const PointCloud& cloud,
-                                       const LinkClusteringResult& result);
+absl::StatusOr<PointCloud> ApplyFilter(const PointCloud& cloud, const LinkClusteringResult& result);
 
 namespace internal {
 // Shared by both paths once the clusters and their sizes are known: decides

@@ -51,16 +51,16 @@ int32_t Find(std::vector<int32_t>& parent, int32_t i) {
 void Union(std::vector<int32_t>& parent, int32_t a, int32_t b) {
   a = Find(parent, a);
   b = Find(parent, b);
-  if (a < b) parent[b] = a;
-  else if (b < a) parent[a] = b;
+  if (a < b)
+    parent[b] = a;
+  else if (b < a)
+    parent[a] = b;
 }
 
 }  // namespace
 
-absl::Status ClusterLinksOrganized(const PointCloud& cloud,
-                                   const LinkClusteringSettings& settings,
-                                   LinkClusteringResult& result,
-                                   const std::atomic<bool>* cancel) {
+absl::Status ClusterLinksOrganized(const PointCloud& cloud, const LinkClusteringSettings& settings,
+                                   LinkClusteringResult& result, const std::atomic<bool>* cancel) {
   if (auto st = internal::CheckInput(cloud, settings); !st.ok()) return st;
   const uint32_t w = cloud.width, h = cloud.height;
   const uint32_t words = (w + 63) / 64;
@@ -83,8 +83,7 @@ absl::Status ClusterLinksOrganized(const PointCloud& cloud,
 
   // Pass 1: runs and their unions, row by row.
   for (uint32_t r = 0; r < h; ++r) {
-    if (IsCancelled(cancel))
-      return absl::CancelledError("link clustering: cancelled");
+    if (IsCancelled(cancel)) return absl::CancelledError("link clustering: cancelled");
     RowSoA& cur = rows[r & 1];
     const RowSoA& up = rows[(r + 1) & 1];
     link_row::Transpose(&cloud.points[std::size_t{r} * w], w, cur);

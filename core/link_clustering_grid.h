@@ -24,8 +24,7 @@ namespace surfinspect {
 
 // Grid path on an organized cloud (height == 1 is accepted as one row).
 // Errors as ClusterLinks.
-absl::Status ClusterLinksOrganized(const PointCloud& cloud,
-                                   const LinkClusteringSettings& settings,
+absl::Status ClusterLinksOrganized(const PointCloud& cloud, const LinkClusteringSettings& settings,
                                    LinkClusteringResult& result,
                                    const std::atomic<bool>* cancel = nullptr);
 

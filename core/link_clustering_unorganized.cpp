@@ -117,8 +117,7 @@ absl::Status ClusterLinksUnorganized(const PointCloud& cloud,
     if (!(cells < static_cast<double>(uint64_t{1} << kMaxAxisBits)))
       return absl::InvalidArgumentError(absl::StrCat(
           "link clustering: the cloud spans ", hi[a] - lo[a], " mm on axis ", a,
-          ", more than 2^21 cells for a link distance of ", settings.link_distance_mm,
-          " mm"));
+          ", more than 2^21 cells for a link distance of ", settings.link_distance_mm, " mm"));
     bits[a] = BitsFor(static_cast<uint64_t>(cells) - 1);
   }
 
@@ -130,8 +129,7 @@ absl::Status ClusterLinksUnorganized(const PointCloud& cloud,
     const Eigen::Vector3f& p = cloud.points[i];
     if (!PointCloud::IsValid(p)) continue;
     uint64_t c[3];
-    for (int a = 0; a < 3; ++a)
-      c[a] = static_cast<uint64_t>(std::floor((p[a] - lo[a]) / cell)) + 2;
+    for (int a = 0; a < 3; ++a) c[a] = static_cast<uint64_t>(std::floor((p[a] - lo[a]) / cell)) + 2;
     keys.push_back(c[0] | (c[1] << bits[0]) | (c[2] << (bits[0] + bits[1])));
     order.push_back(static_cast<uint32_t>(i));
   }

@@ -66,8 +66,8 @@ bool RowBits(const RowSoA& cur, const RowSoA& up, uint32_t words, float r2, cons
     for (uint32_t j = 0; j < 64; j += 4) {
       const uint32_t i = 64 * k + j;
       const __m128 px = _mm_loadu_ps(x + i), py = _mm_loadu_ps(y + i), pz = _mm_loadu_ps(z + i);
-      const __m128 s = _mm_add_ps(_mm_add_ps(_mm_mul_ps(px, zero), _mm_mul_ps(py, zero)),
-                                  _mm_mul_ps(pz, zero));
+      const __m128 s =
+          _mm_add_ps(_mm_add_ps(_mm_mul_ps(px, zero), _mm_mul_ps(py, zero)), _mm_mul_ps(pz, zero));
       valid |= uint64_t(_mm_movemask_ps(_mm_cmpeq_ps(s, zero))) << j;
       any_inf = _mm_or_ps(any_inf, _mm_or_ps(_mm_cmpeq_ps(_mm_and_ps(px, abs_mask), inf),
                                              _mm_cmpeq_ps(_mm_and_ps(py, abs_mask), inf)));

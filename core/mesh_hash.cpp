@@ -39,7 +39,8 @@ std::string MeshSha256(const TriangleMesh& mesh) {
 }
 
 std::string MeshSha256(const std::string& vertex_bytes, const std::string& triangle_bytes) {
-  return Hash(vertex_bytes.data(), vertex_bytes.size(), triangle_bytes.data(), triangle_bytes.size());
+  return Hash(vertex_bytes.data(), vertex_bytes.size(), triangle_bytes.data(),
+              triangle_bytes.size());
 }
 
 }  // namespace surfinspect

@@ -20,8 +20,7 @@ namespace {
 // keeps the true minimiser and every exact tie inside the search, so the
 // double-precision answer is the brute-force answer.
 float SearchRadius(double distance_mm, double coordinate_scale) {
-  if (!(distance_mm < static_cast<double>(std::numeric_limits<float>::max()) / 2))
-    return INFINITY;
+  if (!(distance_mm < static_cast<double>(std::numeric_limits<float>::max()) / 2)) return INFINITY;
   const double padded = distance_mm * (1 + 1e-6) + 1e-6 * coordinate_scale + 1e-9;
   return std::nextafter(static_cast<float>(padded), INFINITY);
 }
@@ -48,12 +47,12 @@ struct QueryState {
     const Eigen::Vector3d pa = p - a;
     const double below = std::abs(pa.dot(face_normals[t])) - 1e-12 * pa.lpNorm<1>();
     if (below > 0 && below * below > best_d2) return false;
-    const PointTriangleResult r =
-        ClosestPointOnTriangle(p, a, vertices[tri[1]].cast<double>(), vertices[tri[2]].cast<double>());
-    const bool better = best_triangle == UINT32_MAX
-                            ? r.squared_distance <= best_d2
-                            : r.squared_distance < best_d2 ||
-                                  (r.squared_distance == best_d2 && t < best_triangle);
+    const PointTriangleResult r = ClosestPointOnTriangle(p, a, vertices[tri[1]].cast<double>(),
+                                                         vertices[tri[2]].cast<double>());
+    const bool better =
+        best_triangle == UINT32_MAX
+            ? r.squared_distance <= best_d2
+            : r.squared_distance < best_d2 || (r.squared_distance == best_d2 && t < best_triangle);
     if (!better) return false;
     best = r;
     best_d2 = r.squared_distance;
@@ -143,7 +142,9 @@ void MeshIndex::ComputePseudonormals() {
   // adjacency, and with it the edge and vertex pseudonormals, is right.
   std::vector<uint32_t> order(verts.size());
   std::iota(order.begin(), order.end(), 0u);
-  auto key = [&](uint32_t i) { return std::make_tuple(verts[i].x(), verts[i].y(), verts[i].z(), i); };
+  auto key = [&](uint32_t i) {
+    return std::make_tuple(verts[i].x(), verts[i].y(), verts[i].z(), i);
+  };
   std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return key(a) < key(b); });
   weld_.resize(verts.size());
   for (std::size_t i = 0; i < order.size();) {
@@ -159,7 +160,8 @@ void MeshIndex::ComputePseudonormals() {
       ++info_.degenerate_triangles;
       continue;  // a zero normal: contributes nothing to its neighbours' sums
     }
-    const Eigen::Vector3d a = verts[tris[t][0]].cast<double>(), b = verts[tris[t][1]].cast<double>(),
+    const Eigen::Vector3d a = verts[tris[t][0]].cast<double>(),
+                          b = verts[tris[t][1]].cast<double>(),
                           c = verts[tris[t][2]].cast<double>();
     face_normal_[t] = (b - a).cross(c - a).normalized();
   }
@@ -213,12 +215,17 @@ const Eigen::Vector3d& MeshIndex::Pseudonormal(uint32_t triangle, ClosestFeature
 }
 
 ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_distance_mm,
-                               uint32_t hint_triangle) const {
+                                uint32_t hint_triangle) const {
   ClosestPoint out;
   if (!p_in_mesh.allFinite() || !(max_distance_mm >= 0)) return out;
-  QueryState s{p_in_mesh, mesh_.vertices.data(), mesh_.triangles.data(), face_normal_.data(),
-               p_in_mesh.cwiseAbs().maxCoeff(), max_distance_mm * max_distance_mm,
-               UINT32_MAX, {}};
+  QueryState s{p_in_mesh,
+               mesh_.vertices.data(),
+               mesh_.triangles.data(),
+               face_normal_.data(),
+               p_in_mesh.cwiseAbs().maxCoeff(),
+               max_distance_mm * max_distance_mm,
+               UINT32_MAX,
+               {}};
   // A good first candidate (the previous point's triangle) starts the
   // search with a nearly exact radius; the result is the same without it.
   if (hint_triangle < mesh_.num_triangles()) s.Offer(hint_triangle);
@@ -227,8 +234,8 @@ ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_dis
   query.y = static_cast<float>(p_in_mesh.y());
   query.z = static_cast<float>(p_in_mesh.z());
   query.time = 0.f;
-  query.radius = SearchRadius(s.best_triangle == UINT32_MAX ? max_distance_mm : std::sqrt(s.best_d2),
-                              s.coordinate_scale);
+  query.radius = SearchRadius(
+      s.best_triangle == UINT32_MAX ? max_distance_mm : std::sqrt(s.best_d2), s.coordinate_scale);
   // Beyond float range Embree cannot place the point; such a point is unmatched.
   if (!std::isfinite(query.x) || !std::isfinite(query.y) || !std::isfinite(query.z)) return out;
   RTCPointQueryContext context;

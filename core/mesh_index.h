@@ -43,11 +43,13 @@ class EmbreeTriangleScene;
 
 struct ClosestPoint {
   uint32_t triangle_id = UINT32_MAX;  // UINT32_MAX = unmatched
-  Eigen::Vector3d point = Eigen::Vector3d::Constant(NAN);  // closest point on the mesh, mm, mesh frame
+  Eigen::Vector3d point =
+      Eigen::Vector3d::Constant(NAN);  // closest point on the mesh, mm, mesh frame
   ClosestFeature feature = ClosestFeature::kFace;
   double distance_mm = NAN;         // unsigned; NaN if unmatched
   double signed_distance_mm = NAN;  // + on the CCW-normal side; NaN if unmatched
-  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // unit face normal of triangle_id (0 if degenerate)
+  Eigen::Vector3d normal =
+      Eigen::Vector3d::Zero();  // unit face normal of triangle_id (0 if degenerate)
   bool matched() const { return triangle_id != UINT32_MAX; }
 };
 
@@ -142,9 +144,9 @@ absl::StatusOr<std::vector<ClosestPoint>> QueryClosest(const MeshIndex& index,
 // The same, streaming: `sink(i, result)` is called exactly once for every
 // input index i, concurrently from worker threads (for different i), so
 // callers can store only the fields they need.
-absl::Status QueryClosestEach(
-    const MeshIndex& index, const PointCloud& points, const Eigen::Isometry3d& mesh_from_points,
-    const BatchQuerySettings& settings, const std::atomic<bool>* cancel,
-    absl::FunctionRef<void(std::size_t, const ClosestPoint&)> sink);
+absl::Status QueryClosestEach(const MeshIndex& index, const PointCloud& points,
+                              const Eigen::Isometry3d& mesh_from_points,
+                              const BatchQuerySettings& settings, const std::atomic<bool>* cancel,
+                              absl::FunctionRef<void(std::size_t, const ClosestPoint&)> sink);
 
 }  // namespace surfinspect

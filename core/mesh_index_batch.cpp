@@ -6,9 +6,9 @@
 // |p - p_prev|, an upper bound on the answer by the triangle inequality, and
 // offers the previous point's triangle first, which usually tightens the
 // radius to nearly the answer, so Embree prunes from the root instead of
-// descending towards an arbitrary first leaf. Chunk boundaries do not depend on the thread count and the
-// index breaks ties by triangle id, so results are identical for 1 and N
-// threads and with or without the coherent start.
+// descending towards an arbitrary first leaf. Chunk boundaries do not depend on the thread count
+// and the index breaks ties by triangle id, so results are identical for 1 and N threads and with
+// or without the coherent start.
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -57,8 +57,7 @@ std::vector<uint32_t> MortonOrder(const PointCloud& cloud, const std::atomic<boo
     if (PointCloud::IsValid(p)) {
       std::array<uint64_t, 3> q;
       for (int a = 0; a < 3; ++a)
-        q[a] = static_cast<uint64_t>(
-            std::clamp((p[a] - bounds.min[a]) * scale, 0.0, 1023.0));
+        q[a] = static_cast<uint64_t>(std::clamp((p[a] - bounds.min[a]) * scale, 0.0, 1023.0));
       code = Spread10(q[0]) | (Spread10(q[1]) << 1) | (Spread10(q[2]) << 2);
     }
     keys[i] = (code << 32) | i;
@@ -82,12 +81,12 @@ absl::Status CheckInputs(const PointCloud& points, const Eigen::Isometry3d& mesh
                          const BatchQuerySettings& settings) {
   if (auto st = points.Validate(); !st.ok()) return st;
   if (!(settings.max_distance_mm >= 0))
-    return absl::InvalidArgumentError(absl::StrCat(
-        "closest-point query: max_distance_mm must be >= 0 (or inf), got ",
-        settings.max_distance_mm));
+    return absl::InvalidArgumentError(
+        absl::StrCat("closest-point query: max_distance_mm must be >= 0 (or inf), got ",
+                     settings.max_distance_mm));
   if (settings.threads < 0 || settings.threads > kMaxThreads)
-    return absl::InvalidArgumentError(absl::StrCat(
-        "closest-point query: threads must be in [0, ", kMaxThreads, "], got ", settings.threads));
+    return absl::InvalidArgumentError(absl::StrCat("closest-point query: threads must be in [0, ",
+                                                   kMaxThreads, "], got ", settings.threads));
   if (!mesh_from_points.matrix().allFinite())
     return absl::InvalidArgumentError("closest-point query: mesh_from_points is not finite");
   return absl::OkStatus();
@@ -95,10 +94,10 @@ absl::Status CheckInputs(const PointCloud& points, const Eigen::Isometry3d& mesh
 
 }  // namespace
 
-absl::Status QueryClosestEach(
-    const MeshIndex& index, const PointCloud& points, const Eigen::Isometry3d& mesh_from_points,
-    const BatchQuerySettings& settings, const std::atomic<bool>* cancel,
-    absl::FunctionRef<void(std::size_t, const ClosestPoint&)> sink) {
+absl::Status QueryClosestEach(const MeshIndex& index, const PointCloud& points,
+                              const Eigen::Isometry3d& mesh_from_points,
+                              const BatchQuerySettings& settings, const std::atomic<bool>* cancel,
+                              absl::FunctionRef<void(std::size_t, const ClosestPoint&)> sink) {
   if (auto st = CheckInputs(points, mesh_from_points, settings); !st.ok()) return st;
   const std::size_t n = points.size();
   if (n == 0) return absl::OkStatus();
@@ -129,7 +128,8 @@ absl::Status QueryClosestEach(
         radius = std::min(radius, (prev_d + (p - prev_p).norm()) * (1 + 1e-12) + 1e-12);
       // The previous point's triangle, offered first, usually makes the
       // radius nearly exact at once.
-      ClosestPoint r = index.Closest(p, radius, settings.coherent_start ? prev_triangle : UINT32_MAX);
+      ClosestPoint r =
+          index.Closest(p, radius, settings.coherent_start ? prev_triangle : UINT32_MAX);
       // The bound holds exactly; this only guards against its rounding.
       if (!r.matched() && radius < max_d) r = index.Closest(p, max_d);
       sink(i, r);
@@ -169,8 +169,8 @@ absl::StatusOr<std::vector<ClosestPoint>> QueryClosest(const MeshIndex& index,
   try {
     out.resize(points.size());
   } catch (const std::bad_alloc&) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat("closest-point query: cannot allocate results for ", points.size(), " points"));
+    return absl::ResourceExhaustedError(absl::StrCat(
+        "closest-point query: cannot allocate results for ", points.size(), " points"));
   }
   auto st = QueryClosestEach(index, points, mesh_from_points, settings, cancel,
                              [&out](std::size_t i, const ClosestPoint& r) { out[i] = r; });

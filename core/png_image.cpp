@@ -63,14 +63,16 @@ void RgbImage::DrawText(int x, int y, const std::string& text, Rgb c, int scale)
     if (it != Glyphs().end())
       for (int row = 0; row < 7; ++row)
         for (int col = 0; col < 5; ++col)
-          if (it->second[row] & (16 >> col)) FillRect(pen + col * scale, y + row * scale, scale, scale, c);
+          if (it->second[row] & (16 >> col))
+            FillRect(pen + col * scale, y + row * scale, scale, scale, c);
     pen += 6 * scale;
   }
 }
 
 namespace {
 void AppendToString(png_structp png, png_bytep data, png_size_t length) {
-  static_cast<std::string*>(png_get_io_ptr(png))->append(reinterpret_cast<const char*>(data), length);
+  static_cast<std::string*>(png_get_io_ptr(png))
+      ->append(reinterpret_cast<const char*>(data), length);
 }
 void NoFlush(png_structp) {}
 }  // namespace
@@ -97,7 +99,8 @@ absl::StatusOr<std::string> EncodePng(const RgbImage& image) {
                PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   png_write_info(png, info);
   for (uint32_t y = 0; y < image.height; ++y)
-    png_write_row(png, reinterpret_cast<png_const_bytep>(&image.pixels[std::size_t{y} * image.width]));
+    png_write_row(png,
+                  reinterpret_cast<png_const_bytep>(&image.pixels[std::size_t{y} * image.width]));
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
   return out;
@@ -105,7 +108,8 @@ absl::StatusOr<std::string> EncodePng(const RgbImage& image) {
 
 absl::Status WritePng(const std::string& path, const RgbImage& image) {
   auto bytes = EncodePng(image);
-  if (!bytes.ok()) return absl::Status(bytes.status().code(), absl::StrCat(path, ": ", bytes.status().message()));
+  if (!bytes.ok())
+    return absl::Status(bytes.status().code(), absl::StrCat(path, ": ", bytes.status().message()));
   return WriteStringAtomically(path, *bytes);
 }
 

@@ -24,7 +24,8 @@ struct RgbImage {
   std::vector<Rgb> pixels;  // row-major, top row first
 
   RgbImage() = default;
-  RgbImage(uint32_t w, uint32_t h, Rgb fill = {}) : width(w), height(h), pixels(std::size_t{w} * h, fill) {}
+  RgbImage(uint32_t w, uint32_t h, Rgb fill = {})
+      : width(w), height(h), pixels(std::size_t{w} * h, fill) {}
   Rgb& at(uint32_t x, uint32_t y) { return pixels[std::size_t{y} * width + x]; }
   const Rgb& at(uint32_t x, uint32_t y) const { return pixels[std::size_t{y} * width + x]; }
   // Clipped to the image.

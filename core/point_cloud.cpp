@@ -16,8 +16,7 @@ PointCloud PointCloud::Organized(uint32_t width, uint32_t height) {
   PointCloud c;
   c.width = width;
   c.height = height;
-  c.points.assign(static_cast<std::size_t>(width) * height,
-                  Eigen::Vector3f::Constant(NAN));
+  c.points.assign(static_cast<std::size_t>(width) * height, Eigen::Vector3f::Constant(NAN));
   return c;
 }
 
@@ -29,9 +28,8 @@ std::size_t PointCloud::CountValid() const {
 
 absl::Status PointCloud::Validate() const {
   if (static_cast<std::size_t>(width) * height != points.size())
-    return absl::InvalidArgumentError(
-        absl::StrCat("cloud: width*height = ", width, "*", height,
-                     " does not match ", points.size(), " points"));
+    return absl::InvalidArgumentError(absl::StrCat("cloud: width*height = ", width, "*", height,
+                                                   " does not match ", points.size(), " points"));
   return ValidatePoints(0, points.size());
 }
 
@@ -49,8 +47,7 @@ absl::Status PointCloud::ValidatePoints(std::size_t first, std::size_t last) con
 
 Bounds3 ComputeBounds(const PointCloud& cloud) {
   Bounds3 b;
-  cloud.ForEachValid(
-      [&](std::size_t, const Eigen::Vector3f& p) { b.Extend(p.cast<double>()); });
+  cloud.ForEachValid([&](std::size_t, const Eigen::Vector3f& p) { b.Extend(p.cast<double>()); });
   return b;
 }
 

@@ -12,7 +12,8 @@ absl::StatusOr<MergedCloud> RegisterToWorld(const std::vector<ViewScan>& views) 
   std::size_t total = 0;
   for (const auto& v : views) {
     if (auto st = v.cloud_in_sensor.Validate(); !st.ok())
-      return absl::InvalidArgumentError(absl::StrCat("register: view '", v.name, "': ", st.message()));
+      return absl::InvalidArgumentError(
+          absl::StrCat("register: view '", v.name, "': ", st.message()));
     // Re-check rigidity: a matrix that slipped past validation would scale
     // the part and fake a shape error.
     auto rigid = FromRowMajor(ToRowMajor(v.world_from_sensor), "world_from_sensor of " + v.name);
@@ -47,7 +48,8 @@ IcpSettings DefaultBestFitSettings() {
   return s;
 }
 
-absl::StatusOr<BestFitResult> BestFitToCad(const MeshIndex& part, const Eigen::Isometry3d& world_from_part,
+absl::StatusOr<BestFitResult> BestFitToCad(const MeshIndex& part,
+                                           const Eigen::Isometry3d& world_from_part,
                                            const MergedCloud& merged, const IcpSettings& settings,
                                            const std::atomic<bool>* cancel) {
   auto icp = RunIcp(part, merged.cloud_in_world, world_from_part.inverse(), settings, cancel);

@@ -22,15 +22,15 @@
 namespace surfinspect {
 
 struct ViewScan {
-  std::string name;                      // viewpoint name, e.g. "v1"
-  PointCloud cloud_in_sensor;            // organized or not, mm
+  std::string name;                                                     // viewpoint name, e.g. "v1"
+  PointCloud cloud_in_sensor;                                           // organized or not, mm
   Eigen::Isometry3d world_from_sensor = Eigen::Isometry3d::Identity();  // calibrated
 };
 
 struct MergedCloud {
-  PointCloud cloud_in_world;             // valid points only, unorganized, mm
-  std::vector<uint16_t> view_id;         // per point: index into view_names
-  std::vector<uint32_t> grid_index;      // per point: row * width + col in its scan
+  PointCloud cloud_in_world;         // valid points only, unorganized, mm
+  std::vector<uint16_t> view_id;     // per point: index into view_names
+  std::vector<uint32_t> grid_index;  // per point: row * width + col in its scan
   std::vector<std::string> view_names;
   std::vector<std::size_t> points_per_view;
 };
@@ -42,7 +42,7 @@ struct BestFitResult {
   // Maps registered world points to best-fitted world points
   // (world_fitted_from_world); apply it with TransformCloud.
   Eigen::Isometry3d correction = Eigen::Isometry3d::Identity();
-  double translation_mm = 0;             // size of the correction
+  double translation_mm = 0;  // size of the correction
   double rotation_deg = 0;
   IcpResult icp;
 };

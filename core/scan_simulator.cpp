@@ -29,7 +29,7 @@ struct PixelRng {
     return z ^ (z >> 31);
   }
   double Uniform() { return (Next() >> 11) * 0x1.0p-53; }  // [0, 1)
-  double Gaussian() {  // Box-Muller
+  double Gaussian() {                                      // Box-Muller
     const double u1 = std::max(Uniform(), 1e-300), u2 = Uniform();
     return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
   }
@@ -193,7 +193,9 @@ absl::StatusOr<SimulatedScan> SimulateScan(const TriangleMesh& mesh_in_part,
           if (!far_void && far_range - near_range < opt.stripe_min_jump_mm) continue;
           PixelRng rng(opt.seed, i * 4 + k, kStripeStream);
           if (rng.Uniform() >= opt.stripe_probability) continue;
-          const uint32_t len = 2 + static_cast<uint32_t>(rng.Uniform() * std::max<uint32_t>(1, opt.stripe_max_length - 1));
+          const uint32_t len =
+              2 + static_cast<uint32_t>(rng.Uniform() *
+                                        std::max<uint32_t>(1, opt.stripe_max_length - 1));
           const double far_end = far_void ? near_range + 3.0 + 12.0 * rng.Uniform() : far_range;
           for (uint32_t step = 1; step <= len; ++step) {
             const long r = long(row) + dr[k] * long(step), c = long(col) + dc[k] * long(step);
@@ -212,7 +214,8 @@ absl::StatusOr<SimulatedScan> SimulateScan(const TriangleMesh& mesh_in_part,
 
   for (std::size_t i = 0; i < n; ++i) {
     if (!std::isfinite(range[i])) continue;
-    const uint32_t row = static_cast<uint32_t>(i / in.width), col = static_cast<uint32_t>(i % in.width);
+    const uint32_t row = static_cast<uint32_t>(i / in.width),
+                   col = static_cast<uint32_t>(i % in.width);
     const Eigen::Vector3d ray = ray_in_sensor(col, row);
     double t = range[i];
     if (out.labels[i] != PixelLabel::kStripe && opt.pulse_fraction > 0) {
@@ -225,7 +228,8 @@ absl::StatusOr<SimulatedScan> SimulateScan(const TriangleMesh& mesh_in_part,
         out.triangle_id[i] = UINT32_MAX;
       }
     }
-    if (opt.noise_sigma_mm > 0) t += opt.noise_sigma_mm * PixelRng(opt.seed, i, kNoiseStream).Gaussian();
+    if (opt.noise_sigma_mm > 0)
+      t += opt.noise_sigma_mm * PixelRng(opt.seed, i, kNoiseStream).Gaussian();
     // Range t is frame-independent (rigid motion), so the point is built in
     // the sensor frame directly: no round trip through the part frame.
     const Eigen::Vector3d p_sensor = t * ray;

@@ -19,11 +19,11 @@
 namespace surfinspect {
 
 struct SensorIntrinsics {
-  uint32_t width = 1024;               // pixels (columns)
-  uint32_t height = 768;               // pixels (rows)
-  double horizontal_fov_deg = 35.0;    // full horizontal field of view
-  double min_range_mm = 250.0;         // points nearer than this are invalid
-  double max_range_mm = 600.0;         // points farther than this are invalid
+  uint32_t width = 1024;             // pixels (columns)
+  uint32_t height = 768;             // pixels (rows)
+  double horizontal_fov_deg = 35.0;  // full horizontal field of view
+  double min_range_mm = 250.0;       // points nearer than this are invalid
+  double max_range_mm = 600.0;       // points farther than this are invalid
 };
 
 // A Gaussian deformation of the true surface: displacement along the
@@ -32,7 +32,7 @@ struct SensorIntrinsics {
 // (into the material, below the CAD surface); depth_mm < 0 is a bump.
 struct SurfaceDefect {
   Eigen::Vector3d center_in_part = Eigen::Vector3d::Zero();  // mm, on the surface
-  double radius_mm = 5.0;   // where the deformation has fallen to exp(-2) = 13.5%
+  double radius_mm = 5.0;  // where the deformation has fallen to exp(-2) = 13.5%
   double depth_mm = 0.1;
 };
 
@@ -58,8 +58,8 @@ enum class PixelLabel : uint8_t {
 };
 
 struct SimulatedScan {
-  PointCloud cloud_in_sensor;            // organized width x height, mm
-  std::vector<PixelLabel> labels;        // per pixel
+  PointCloud cloud_in_sensor;      // organized width x height, mm
+  std::vector<PixelLabel> labels;  // per pixel
   // Per pixel: signed deviation of the measured (true, deformed) surface from
   // the CAD surface along its normal before noise, mm (+ above, - below);
   // NaN for no-data, pulse and stripe pixels.

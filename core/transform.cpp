@@ -14,8 +14,7 @@ RowMajor16 ToRowMajor(const Eigen::Isometry3d& t) {
   return out;
 }
 
-absl::StatusOr<Eigen::Isometry3d> FromRowMajor(const RowMajor16& v,
-                                               absl::string_view what) {
+absl::StatusOr<Eigen::Isometry3d> FromRowMajor(const RowMajor16& v, absl::string_view what) {
   Eigen::Matrix4d m;
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) {
@@ -25,16 +24,15 @@ absl::StatusOr<Eigen::Isometry3d> FromRowMajor(const RowMajor16& v,
             absl::StrCat(what, ": element (", r, ",", c, ") is not finite"));
       m(r, c) = x;
     }
-  if (std::abs(m(3, 0)) > 1e-9 || std::abs(m(3, 1)) > 1e-9 ||
-      std::abs(m(3, 2)) > 1e-9 || std::abs(m(3, 3) - 1) > 1e-9)
-    return absl::InvalidArgumentError(
-        absl::StrCat(what, ": last row must be 0 0 0 1"));
+  if (std::abs(m(3, 0)) > 1e-9 || std::abs(m(3, 1)) > 1e-9 || std::abs(m(3, 2)) > 1e-9 ||
+      std::abs(m(3, 3) - 1) > 1e-9)
+    return absl::InvalidArgumentError(absl::StrCat(what, ": last row must be 0 0 0 1"));
   const Eigen::Matrix3d r = m.topLeftCorner<3, 3>();
   const double ortho_error = (r.transpose() * r - Eigen::Matrix3d::Identity()).norm();
   if (ortho_error > 1e-6 || r.determinant() < 0)
-    return absl::InvalidArgumentError(absl::StrCat(
-        what, ": upper-left 3x3 is not a rotation (|R^T R - I| = ", ortho_error,
-        ", det = ", r.determinant(), ")"));
+    return absl::InvalidArgumentError(
+        absl::StrCat(what, ": upper-left 3x3 is not a rotation (|R^T R - I| = ", ortho_error,
+                     ", det = ", r.determinant(), ")"));
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
   // Re-orthonormalise only what needs it: a matrix that is already a
   // rotation to rounding keeps its exact bits (so a transform survives

@@ -19,9 +19,9 @@ RowMajor16 ToRowMajor(const Eigen::Isometry3d& t);
 // Accepts a 4x4 whose upper-left 3x3 is a rotation to within 1e-6 (R^T R = I,
 // det = +1), whose last row is 0 0 0 1 and whose entries are finite. A
 // rotation off by more than 1e-12 (e.g. printed with few digits) is
-// re-orthonormalised; otherwise the matrix is kept bit for bit. `what` names the transform in the error message.
-absl::StatusOr<Eigen::Isometry3d> FromRowMajor(const RowMajor16& m,
-                                               absl::string_view what);
+// re-orthonormalised; otherwise the matrix is kept bit for bit. `what` names the transform in the
+// error message.
+absl::StatusOr<Eigen::Isometry3d> FromRowMajor(const RowMajor16& m, absl::string_view what);
 
 // Applies `to_from` to every valid point; NaN pixels stay NaN, so an
 // organized grid stays organized. Computed in double, stored as float.

@@ -9,9 +9,7 @@
 namespace surfinspect {
 namespace {
 
-Eigen::Vector3d V(const TriangleMesh& m, uint32_t i) {
-  return m.vertices[i].cast<double>();
-}
+Eigen::Vector3d V(const TriangleMesh& m, uint32_t i) { return m.vertices[i].cast<double>(); }
 
 }  // namespace
 
@@ -51,9 +49,8 @@ absl::Status TriangleMesh::Validate() const {
   for (std::size_t t = 0; t < triangles.size(); ++t)
     for (uint32_t v : triangles[t])
       if (v >= vertices.size())
-        return absl::InvalidArgumentError(absl::StrCat(
-            "mesh: triangle ", t, " refers to vertex ", v, " but there are only ",
-            vertices.size()));
+        return absl::InvalidArgumentError(absl::StrCat("mesh: triangle ", t, " refers to vertex ",
+                                                       v, " but there are only ", vertices.size()));
   if (CountDegenerate() == triangles.size())
     return absl::InvalidArgumentError(
         absl::StrCat("mesh: all ", triangles.size(), " triangles are degenerate"));

@@ -17,11 +17,11 @@ absl::Status Invalid(const std::string& field, absl::string_view why) {
 
 absl::Status CheckCloudShape(uint64_t width, uint64_t height, const std::string& field,
                              const Limits& limits) {
-  if (width == 0 || height == 0) return Invalid(field, "width and height must be > 0 (empty cloud)");
+  if (width == 0 || height == 0)
+    return Invalid(field, "width and height must be > 0 (empty cloud)");
   if (width * height > limits.max_points)
-    return absl::ResourceExhaustedError(absl::StrCat(field, ": ", width * height,
-                                                     " points exceed the server limit of ",
-                                                     limits.max_points));
+    return absl::ResourceExhaustedError(absl::StrCat(
+        field, ": ", width * height, " points exceed the server limit of ", limits.max_points));
   return absl::OkStatus();
 }
 
@@ -29,8 +29,8 @@ absl::StatusOr<PointCloud> CloudFromBytes(const std::string& xyz, uint32_t width
                                           const std::string& field) {
   const uint64_t n = uint64_t{width} * height;
   if (xyz.size() != n * 12)
-    return Invalid(field, absl::StrCat("xyz holds ", xyz.size(), " bytes but width*height*12 = ",
-                                       n * 12));
+    return Invalid(field,
+                   absl::StrCat("xyz holds ", xyz.size(), " bytes but width*height*12 = ", n * 12));
   PointCloud c;
   c.width = width;
   c.height = height;
@@ -56,14 +56,16 @@ absl::Status CloudAssembler::Add(const std::string& chunk, const std::string& fi
   // Check the points this chunk completed while they are in cache and the
   // next chunk is still on the wire, so Take() has nothing left to scan.
   const uint64_t done = received_ / 12;
-  if (auto st = cloud_.ValidatePoints(checked_, done); !st.ok()) return Invalid(field, st.message());
+  if (auto st = cloud_.ValidatePoints(checked_, done); !st.ok())
+    return Invalid(field, st.message());
   checked_ = done;
   return absl::OkStatus();
 }
 
 absl::StatusOr<PointCloud> CloudAssembler::Take(const std::string& field) {
   if (!complete())
-    return Invalid(field, absl::StrCat("incomplete: ", received_, " of ", expected_bytes(), " bytes"));
+    return Invalid(field,
+                   absl::StrCat("incomplete: ", received_, " of ", expected_bytes(), " bytes"));
   PointCloud c = std::move(cloud_);
   cloud_ = PointCloud();
   received_ = checked_ = 0;
@@ -82,7 +84,8 @@ void CloudToProto(const PointCloud& cloud, v1::PointCloud* msg) {
   msg->mutable_xyz()->assign(reinterpret_cast<const char*>(cloud.points.data()), cloud.size() * 12);
 }
 
-absl::StatusOr<Eigen::Isometry3d> TransformFromProto(const v1::Transform& msg, const std::string& field) {
+absl::StatusOr<Eigen::Isometry3d> TransformFromProto(const v1::Transform& msg,
+                                                     const std::string& field) {
   if (msg.row_major_size() != 16)
     return Invalid(field, absl::StrCat("needs 16 row-major values, got ", msg.row_major_size()));
   RowMajor16 v{};
@@ -101,9 +104,8 @@ absl::StatusOr<TriangleMesh> MeshFromProto(const v1::InlineMesh& msg, const std:
     return Invalid(field, "vertices and triangles must be whole 12-byte records");
   const uint64_t nt = msg.triangles().size() / 12;
   if (nt > limits.max_triangles)
-    return absl::ResourceExhaustedError(absl::StrCat(field, ": ", nt,
-                                                     " triangles exceed the server limit of ",
-                                                     limits.max_triangles));
+    return absl::ResourceExhaustedError(absl::StrCat(
+        field, ": ", nt, " triangles exceed the server limit of ", limits.max_triangles));
   TriangleMesh m;
   m.vertices.resize(msg.vertices().size() / 12);
   m.triangles.resize(nt);
@@ -151,13 +153,19 @@ void FilterStatsToProto(const LinkClusteringResult& r, v1::FilterStats* msg) {
   msg->set_removed_clusters(removed_clusters);
 }
 
-absl::StatusOr<IcpSettings> IcpSettingsFromProto(const v1::IcpSettings& msg, const std::string& field) {
+absl::StatusOr<IcpSettings> IcpSettingsFromProto(const v1::IcpSettings& msg,
+                                                 const std::string& field) {
   IcpSettings s;
   switch (msg.step()) {
     case v1::IcpSettings::STEP_UNSPECIFIED:
-    case v1::IcpSettings::STEP_POINT_TO_POINT: s.step = IcpStep::kPointToPoint; break;
-    case v1::IcpSettings::STEP_POINT_TO_PLANE: s.step = IcpStep::kPointToPlane; break;
-    default: return Invalid(field + ".step", "unknown step");
+    case v1::IcpSettings::STEP_POINT_TO_POINT:
+      s.step = IcpStep::kPointToPoint;
+      break;
+    case v1::IcpSettings::STEP_POINT_TO_PLANE:
+      s.step = IcpStep::kPointToPlane;
+      break;
+    default:
+      return Invalid(field + ".step", "unknown step");
   }
   if (msg.has_max_iterations()) {
     if (msg.max_iterations() > 10000) return Invalid(field + ".max_iterations", "must be <= 10000");
@@ -216,7 +224,8 @@ absl::StatusOr<ErrorMapSettings> ErrorMapSettingsFromProto(const v1::ErrorMapSet
   ErrorMapSettings s;
   if (msg.has_tolerance_mm()) s.tolerance_mm = msg.tolerance_mm();
   if (msg.has_max_distance_mm()) s.max_distance_mm = msg.max_distance_mm();
-  if (msg.has_allowed_fraction_outside()) s.allowed_fraction_outside = msg.allowed_fraction_outside();
+  if (msg.has_allowed_fraction_outside())
+    s.allowed_fraction_outside = msg.allowed_fraction_outside();
   if (msg.has_histogram_bins()) {
     if (msg.histogram_bins() > 10001) return Invalid(field + ".histogram_bins", "must be <= 10001");
     s.histogram_bins = static_cast<int>(msg.histogram_bins());

@@ -21,8 +21,8 @@ namespace surfinspect::wire {
 namespace v1 = ::surfinspect::v1;
 
 struct Limits {
-  uint64_t max_points = 20'000'000;     // per cloud (and per merged part)
-  uint64_t max_triangles = 5'000'000;   // per mesh
+  uint64_t max_points = 20'000'000;    // per cloud (and per merged part)
+  uint64_t max_triangles = 5'000'000;  // per mesh
 };
 
 // ---- clouds ----
@@ -76,7 +76,8 @@ absl::StatusOr<LinkClusteringSettings> FilterSettingsFromProto(
 void FilterSettingsToProto(const LinkClusteringSettings& s, v1::FilterSettings* msg);
 void FilterStatsToProto(const LinkClusteringResult& r, v1::FilterStats* msg);
 
-absl::StatusOr<IcpSettings> IcpSettingsFromProto(const v1::IcpSettings& msg, const std::string& field);
+absl::StatusOr<IcpSettings> IcpSettingsFromProto(const v1::IcpSettings& msg,
+                                                 const std::string& field);
 void IcpSettingsToProto(const IcpSettings& s, v1::IcpSettings* msg);
 void CalibrationToProto(const CalibrationResult& r, v1::CalibrateResponse* msg);
 

@@ -7,7 +7,9 @@
 namespace surfinspect::server {
 
 InspectReactor::InspectReactor(InspectionService* service, grpc::CallbackServerContext* ctx)
-    : service_(service), ctx_(ctx), request_id_(service->RequestId(ctx)),
+    : service_(service),
+      ctx_(ctx),
+      request_id_(service->RequestId(ctx)),
       start_(std::chrono::steady_clock::now()) {
   if (grpc::Status auth = service_->Authorize(ctx_); !auth.ok()) {
     RequestFinish(auth);
@@ -25,7 +27,8 @@ grpc::Status InspectReactor::Consume(const v1::InspectRequest& msg) {
   const wire::Limits& limits = service_->config().limits;
   switch (msg.message_case()) {
     case v1::InspectRequest::kPart: {
-      if (state_ != State::kExpectPart) return InvalidField("part", "only one part header per stream");
+      if (state_ != State::kExpectPart)
+        return InvalidField("part", "only one part header per stream");
       header_ = msg.part();
       if (header_.part_id().empty() || header_.part_id().size() > 256)
         return InvalidField("part.part_id", "must be 1..256 characters");
@@ -34,26 +37,32 @@ grpc::Status InspectReactor::Consume(const v1::InspectRequest& msg) {
       // A mesh sent by hash is looked up now, so a miss fails before the
       // client streams its views; an inline mesh is indexed on the pool.
       if (header_.part().source_case() == v1::MeshRef::kSha256)
-        if (grpc::Status st = service_->ResolveMesh(ctx_, header_.part(), "part.part", &part_); !st.ok())
+        if (grpc::Status st = service_->ResolveMesh(ctx_, header_.part(), "part.part", &part_);
+            !st.ok())
           return st;
-      if (auto t = wire::TransformFromProto(header_.world_from_part(), "part.world_from_part"); !t.ok())
+      if (auto t = wire::TransformFromProto(header_.world_from_part(), "part.world_from_part");
+          !t.ok())
         return ToGrpc(t.status());
       if (auto s = wire::ErrorMapSettingsFromProto(header_.error_map(), "part.error_map"); !s.ok())
         return ToGrpc(s.status());
-      if (auto f = wire::FilterSettingsFromProto(header_.filter(), "part.filter", LinkClusteringSettings::ForInspection()); !f.ok())
+      if (auto f = wire::FilterSettingsFromProto(header_.filter(), "part.filter",
+                                                 LinkClusteringSettings::ForInspection());
+          !f.ok())
         return ToGrpc(f.status());
       state_ = State::kExpectView;
       return grpc::Status::OK;
     }
     case v1::InspectRequest::kView: {
-      if (state_ == State::kExpectPart) return InvalidField("view", "the part header must come first");
+      if (state_ == State::kExpectPart)
+        return InvalidField("view", "the part header must come first");
       if (state_ == State::kInView)
         return InvalidField("view", absl::StrCat("view '", views_.empty() ? "" : "previous",
                                                  "' is incomplete: ", view_cloud_.received_bytes(),
                                                  " of ", view_cloud_.expected_bytes(), " bytes"));
       const v1::ViewHeader& v = msg.view();
       const std::string field = absl::StrCat("view[", views_.size(), "]");
-      if (auto st = wire::CheckCloudShape(v.width(), v.height(), field, limits); !st.ok()) return ToGrpc(st);
+      if (auto st = wire::CheckCloudShape(v.width(), v.height(), field, limits); !st.ok())
+        return ToGrpc(st);
       total_points_ += uint64_t{v.width()} * v.height();
       if (total_points_ > limits.max_points)
         return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
@@ -70,7 +79,8 @@ grpc::Status InspectReactor::Consume(const v1::InspectRequest& msg) {
       return grpc::Status::OK;
     }
     case v1::InspectRequest::kChunk: {
-      if (state_ != State::kInView) return InvalidField("chunk", "a chunk must follow a view header");
+      if (state_ != State::kInView)
+        return InvalidField("chunk", "a chunk must follow a view header");
       const std::string field = absl::StrCat("view '", views_.back().name, "'");
       if (auto st = view_cloud_.Add(msg.chunk().xyz(), field); !st.ok()) return ToGrpc(st);
       if (view_cloud_.complete()) {
@@ -85,9 +95,9 @@ grpc::Status InspectReactor::Consume(const v1::InspectRequest& msg) {
     }
     case v1::InspectRequest::kEnd: {
       if (state_ == State::kInView)
-        return InvalidField("end", absl::StrCat("view '", views_.back().name, "' is incomplete: ",
-                                                view_cloud_.received_bytes(), " of ",
-                                                view_cloud_.expected_bytes(), " bytes"));
+        return InvalidField("end", absl::StrCat("view '", views_.back().name,
+                                                "' is incomplete: ", view_cloud_.received_bytes(),
+                                                " of ", view_cloud_.expected_bytes(), " bytes"));
       if (state_ != State::kExpectView || views_.empty())
         return InvalidField("end", "a part header and at least one view must come first");
       state_ = State::kEnded;
@@ -100,8 +110,8 @@ grpc::Status InspectReactor::Consume(const v1::InspectRequest& msg) {
 
 void InspectReactor::OnReadDone(bool ok) {
   if (!ok) {  // the client closed its side (or the call died) before the end marker
-    RequestFinish(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                               "stream closed before EndOfPart"));
+    RequestFinish(
+        grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, "stream closed before EndOfPart"));
     return;
   }
   if (grpc::Status st = Consume(in_); !st.ok()) {
@@ -136,15 +146,16 @@ void InspectReactor::Compute() {
     if (st.ok()) {
       InspectionSettings settings;
       settings.filter = !header_.skip_filter();
-      settings.filter_settings = *wire::FilterSettingsFromProto(header_.filter(), "part.filter", LinkClusteringSettings::ForInspection());
+      settings.filter_settings = *wire::FilterSettingsFromProto(
+          header_.filter(), "part.filter", LinkClusteringSettings::ForInspection());
       settings.error_map = *wire::ErrorMapSettingsFromProto(header_.error_map(), "part.error_map");
       const Eigen::Isometry3d world_from_part =
           *wire::TransformFromProto(header_.world_from_part(), "part.world_from_part");
       auto progress = [this](InspectionStage stage, const std::string& view, std::size_t points) {
-        const v1::Progress::Stage s = stage == InspectionStage::kViewFiltered ? v1::Progress::STAGE_VIEW_FILTERED
-                                      : stage == InspectionStage::kViewRegistered
-                                          ? v1::Progress::STAGE_VIEW_REGISTERED
-                                          : v1::Progress::STAGE_ERROR_MAP;
+        const v1::Progress::Stage s =
+            stage == InspectionStage::kViewFiltered     ? v1::Progress::STAGE_VIEW_FILTERED
+            : stage == InspectionStage::kViewRegistered ? v1::Progress::STAGE_VIEW_REGISTERED
+                                                        : v1::Progress::STAGE_ERROR_MAP;
         SendProgress(s, view, points);
       };
       auto result = InspectPart(*part, world_from_part, std::move(views_), settings, progress,
@@ -170,8 +181,10 @@ void InspectReactor::Compute() {
         if (header_.return_png()) {
           auto png = ErrorMapPngBytes(result->merged.cloud_in_world, world_from_part,
                                       result->error_map, part->mesh());
-          if (png.ok()) r->set_png(*std::move(png));
-          else st = ToGrpc(png.status());
+          if (png.ok())
+            r->set_png(*std::move(png));
+          else
+            st = ToGrpc(png.status());
         }
         if (st.ok()) Send(std::move(resp));
       }

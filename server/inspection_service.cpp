@@ -30,8 +30,13 @@ class HeavyCall final : public grpc::ServerUnaryReactor {
   using Work = std::function<grpc::Status(const std::atomic<bool>& cancel)>;
   HeavyCall(InspectionService* service, grpc::CallbackServerContext* ctx, const char* method,
             uint64_t points, Work work)
-      : service_(service), ctx_(ctx), method_(method), points_(points), work_(std::move(work)),
-        request_id_(service->RequestId(ctx)), start_(Clock::now()) {}
+      : service_(service),
+        ctx_(ctx),
+        method_(method),
+        points_(points),
+        work_(std::move(work)),
+        request_id_(service->RequestId(ctx)),
+        start_(Clock::now()) {}
 
   void Start() {
     if (grpc::Status auth = service_->Authorize(ctx_); !auth.ok()) return Done(auth);
@@ -82,7 +87,9 @@ grpc::Status FromCore(const absl::Status& st) { return ToGrpc(st); }
 }  // namespace
 
 InspectionService::InspectionService(ServiceConfig config, Metrics* metrics)
-    : config_(std::move(config)), metrics_(metrics), mesh_cache_(config_.mesh_cache_bytes),
+    : config_(std::move(config)),
+      metrics_(metrics),
+      mesh_cache_(config_.mesh_cache_bytes),
       pool_(config_.threads, config_.max_admitted_calls) {}
 
 InspectionService::~InspectionService() = default;
@@ -101,8 +108,8 @@ grpc::Status InspectionService::Authorize(const grpc::CallbackServerContext* ctx
   return grpc::Status::OK;
 }
 
-grpc::Status InspectionService::ResolveMesh(grpc::CallbackServerContext* ctx, const v1::MeshRef& ref,
-                                            const std::string& field,
+grpc::Status InspectionService::ResolveMesh(grpc::CallbackServerContext* ctx,
+                                            const v1::MeshRef& ref, const std::string& field,
                                             std::shared_ptr<const MeshIndex>* out) {
   if (ref.has_inline_()) {
     const std::string hash = MeshSha256(ref.inline_().vertices(), ref.inline_().triangles());
@@ -146,16 +153,21 @@ void InspectionService::LogCall(const std::string& request_id, const std::string
                                 double seconds, double stop_ms) {
   if (config_.json_logs) {
     // spdlog does not escape JSON; nlohmann does.
-    nlohmann::json line = {{"event", "rpc"},          {"request_id", request_id},
-                           {"method", method},        {"peer", peer},
-                           {"points", points},        {"code", CodeName(st.error_code())},
-                           {"message", st.error_message()}, {"seconds", seconds}};
+    nlohmann::json line = {{"event", "rpc"},
+                           {"request_id", request_id},
+                           {"method", method},
+                           {"peer", peer},
+                           {"points", points},
+                           {"code", CodeName(st.error_code())},
+                           {"message", st.error_message()},
+                           {"seconds", seconds}};
     if (!std::isnan(stop_ms)) line["stopped_after_cancel_ms"] = stop_ms;
     spdlog::info("{}", line.dump());
     return;
   }
   const std::string stopped =
-      std::isnan(stop_ms) ? "" : fmt::format(", work stopped {:.1f} ms after the cancellation", stop_ms);
+      std::isnan(stop_ms) ? ""
+                          : fmt::format(", work stopped {:.1f} ms after the cancellation", stop_ms);
   if (st.ok())
     spdlog::info("[{}] {} from {}: OK, {} points, {:.3f} s{}", request_id, method, peer, points,
                  seconds, stopped);
@@ -165,7 +177,8 @@ void InspectionService::LogCall(const std::string& request_id, const std::string
 }
 
 grpc::ServerUnaryReactor* InspectionService::RunHeavy(grpc::CallbackServerContext* ctx,
-                                                      const char* method, uint64_t points, Work work) {
+                                                      const char* method, uint64_t points,
+                                                      Work work) {
   auto* call = new HeavyCall(this, ctx, method, points, std::move(work));
   call->Start();
   return call;
@@ -195,28 +208,32 @@ grpc::ServerUnaryReactor* InspectionService::Calibrate(grpc::CallbackServerConte
                                                        const v1::CalibrateRequest* req,
                                                        v1::CalibrateResponse* resp) {
   const uint64_t points = uint64_t{req->scan().width()} * req->scan().height();
-  return RunHeavy(ctx, "Calibrate", points, [this, ctx, req, resp](const std::atomic<bool>& cancel) {
-    auto world_from_gauge = wire::TransformFromProto(req->world_from_gauge(), "world_from_gauge");
-    if (!world_from_gauge.ok()) return FromCore(world_from_gauge.status());
-    auto initial = wire::TransformFromProto(req->initial_world_from_sensor(), "initial_world_from_sensor");
-    if (!initial.ok()) return FromCore(initial.status());
-    auto scan = wire::CloudFromProto(req->scan(), "scan", config_.limits);
-    if (!scan.ok()) return FromCore(scan.status());
-    CalibrationSettings settings;
-    settings.filter_outliers = !req->skip_filter();
-    auto filter = wire::FilterSettingsFromProto(req->filter(), "filter");
-    if (!filter.ok()) return FromCore(filter.status());
-    settings.filter = *filter;
-    auto icp = wire::IcpSettingsFromProto(req->icp(), "icp");
-    if (!icp.ok()) return FromCore(icp.status());
-    settings.icp = *icp;
-    std::shared_ptr<const MeshIndex> gauge;
-    if (grpc::Status st = ResolveMesh(ctx, req->gauge(), "gauge", &gauge); !st.ok()) return st;
-    auto cal = CalibrateViewpoint(*gauge, *world_from_gauge, *scan, *initial, settings, &cancel);
-    if (!cal.ok()) return FromCore(cal.status());
-    wire::CalibrationToProto(*cal, resp);
-    return grpc::Status::OK;
-  });
+  return RunHeavy(
+      ctx, "Calibrate", points, [this, ctx, req, resp](const std::atomic<bool>& cancel) {
+        auto world_from_gauge =
+            wire::TransformFromProto(req->world_from_gauge(), "world_from_gauge");
+        if (!world_from_gauge.ok()) return FromCore(world_from_gauge.status());
+        auto initial =
+            wire::TransformFromProto(req->initial_world_from_sensor(), "initial_world_from_sensor");
+        if (!initial.ok()) return FromCore(initial.status());
+        auto scan = wire::CloudFromProto(req->scan(), "scan", config_.limits);
+        if (!scan.ok()) return FromCore(scan.status());
+        CalibrationSettings settings;
+        settings.filter_outliers = !req->skip_filter();
+        auto filter = wire::FilterSettingsFromProto(req->filter(), "filter");
+        if (!filter.ok()) return FromCore(filter.status());
+        settings.filter = *filter;
+        auto icp = wire::IcpSettingsFromProto(req->icp(), "icp");
+        if (!icp.ok()) return FromCore(icp.status());
+        settings.icp = *icp;
+        std::shared_ptr<const MeshIndex> gauge;
+        if (grpc::Status st = ResolveMesh(ctx, req->gauge(), "gauge", &gauge); !st.ok()) return st;
+        auto cal =
+            CalibrateViewpoint(*gauge, *world_from_gauge, *scan, *initial, settings, &cancel);
+        if (!cal.ok()) return FromCore(cal.status());
+        wire::CalibrationToProto(*cal, resp);
+        return grpc::Status::OK;
+      });
 }
 
 grpc::ServerUnaryReactor* InspectionService::Register(grpc::CallbackServerContext* ctx,
@@ -224,51 +241,55 @@ grpc::ServerUnaryReactor* InspectionService::Register(grpc::CallbackServerContex
                                                       v1::RegisterResponse* resp) {
   uint64_t points = 0;
   for (const auto& v : req->views()) points += uint64_t{v.cloud().width()} * v.cloud().height();
-  return RunHeavy(ctx, "Register", points, [this, ctx, req, resp, points](const std::atomic<bool>& cancel) {
-    if (req->views().empty()) return InvalidField("views", "at least one view is required");
-    if (points > config_.limits.max_points)
-      return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
-                          absl::StrCat("views: ", points, " points exceed the limit of ",
-                                       config_.limits.max_points));
-    auto filter = wire::FilterSettingsFromProto(req->filter_settings(), "filter_settings");
-    if (!filter.ok()) return FromCore(filter.status());
-    std::vector<ViewScan> views;
-    for (int i = 0; i < req->views_size(); ++i) {
-      const std::string field = absl::StrCat("views[", i, "]");
-      const v1::ViewScan& v = req->views(i);
-      auto pose = wire::TransformFromProto(v.world_from_sensor(), field + ".world_from_sensor");
-      if (!pose.ok()) return FromCore(pose.status());
-      auto cloud = wire::CloudFromProto(v.cloud(), field + ".cloud", config_.limits);
-      if (!cloud.ok()) return FromCore(cloud.status());
-      if (req->filter()) {
-        auto clusters = ClusterLinks(*cloud, *filter, &cancel);
-        if (!clusters.ok()) return FromCore(clusters.status());
-        auto cleaned = ApplyFilter(*cloud, *clusters);
-        if (!cleaned.ok()) return FromCore(cleaned.status());
-        cloud = std::move(cleaned);
-      }
-      views.push_back({v.name().empty() ? absl::StrCat("view", i) : v.name(), *std::move(cloud), *pose});
-    }
-    auto merged = RegisterToWorld(views);
-    if (!merged.ok()) return FromCore(merged.status());
-    if (req->best_fit()) {
-      auto world_from_part = wire::TransformFromProto(req->world_from_part(), "world_from_part");
-      if (!world_from_part.ok()) return FromCore(world_from_part.status());
-      std::shared_ptr<const MeshIndex> part;
-      if (grpc::Status st = ResolveMesh(ctx, req->part(), "part", &part); !st.ok()) return st;
-      auto fit = BestFitToCad(*part, *world_from_part, *merged, DefaultBestFitSettings(), &cancel);
-      if (!fit.ok()) return FromCore(fit.status());
-      merged->cloud_in_world = TransformCloud(merged->cloud_in_world, fit->correction);
-      wire::TransformToProto(fit->correction, resp->mutable_best_fit_correction());
-    }
-    wire::CloudToProto(merged->cloud_in_world, resp->mutable_merged());
-    resp->mutable_view_index()->assign(reinterpret_cast<const char*>(merged->view_id.data()),
-                                       merged->view_id.size() * sizeof(uint16_t));
-    resp->mutable_grid_index()->assign(reinterpret_cast<const char*>(merged->grid_index.data()),
-                                       merged->grid_index.size() * sizeof(uint32_t));
-    for (std::size_t n : merged->points_per_view) resp->add_points_per_view(n);
-    return grpc::Status::OK;
-  });
+  return RunHeavy(
+      ctx, "Register", points, [this, ctx, req, resp, points](const std::atomic<bool>& cancel) {
+        if (req->views().empty()) return InvalidField("views", "at least one view is required");
+        if (points > config_.limits.max_points)
+          return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                              absl::StrCat("views: ", points, " points exceed the limit of ",
+                                           config_.limits.max_points));
+        auto filter = wire::FilterSettingsFromProto(req->filter_settings(), "filter_settings");
+        if (!filter.ok()) return FromCore(filter.status());
+        std::vector<ViewScan> views;
+        for (int i = 0; i < req->views_size(); ++i) {
+          const std::string field = absl::StrCat("views[", i, "]");
+          const v1::ViewScan& v = req->views(i);
+          auto pose = wire::TransformFromProto(v.world_from_sensor(), field + ".world_from_sensor");
+          if (!pose.ok()) return FromCore(pose.status());
+          auto cloud = wire::CloudFromProto(v.cloud(), field + ".cloud", config_.limits);
+          if (!cloud.ok()) return FromCore(cloud.status());
+          if (req->filter()) {
+            auto clusters = ClusterLinks(*cloud, *filter, &cancel);
+            if (!clusters.ok()) return FromCore(clusters.status());
+            auto cleaned = ApplyFilter(*cloud, *clusters);
+            if (!cleaned.ok()) return FromCore(cleaned.status());
+            cloud = std::move(cleaned);
+          }
+          views.push_back(
+              {v.name().empty() ? absl::StrCat("view", i) : v.name(), *std::move(cloud), *pose});
+        }
+        auto merged = RegisterToWorld(views);
+        if (!merged.ok()) return FromCore(merged.status());
+        if (req->best_fit()) {
+          auto world_from_part =
+              wire::TransformFromProto(req->world_from_part(), "world_from_part");
+          if (!world_from_part.ok()) return FromCore(world_from_part.status());
+          std::shared_ptr<const MeshIndex> part;
+          if (grpc::Status st = ResolveMesh(ctx, req->part(), "part", &part); !st.ok()) return st;
+          auto fit =
+              BestFitToCad(*part, *world_from_part, *merged, DefaultBestFitSettings(), &cancel);
+          if (!fit.ok()) return FromCore(fit.status());
+          merged->cloud_in_world = TransformCloud(merged->cloud_in_world, fit->correction);
+          wire::TransformToProto(fit->correction, resp->mutable_best_fit_correction());
+        }
+        wire::CloudToProto(merged->cloud_in_world, resp->mutable_merged());
+        resp->mutable_view_index()->assign(reinterpret_cast<const char*>(merged->view_id.data()),
+                                           merged->view_id.size() * sizeof(uint16_t));
+        resp->mutable_grid_index()->assign(reinterpret_cast<const char*>(merged->grid_index.data()),
+                                           merged->grid_index.size() * sizeof(uint32_t));
+        for (std::size_t n : merged->points_per_view) resp->add_points_per_view(n);
+        return grpc::Status::OK;
+      });
 }
 
 grpc::ServerUnaryReactor* InspectionService::ErrorMap(grpc::CallbackServerContext* ctx,

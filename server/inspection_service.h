@@ -23,10 +23,10 @@ namespace surfinspect::server {
 
 struct ServiceConfig {
   wire::Limits limits;
-  int threads = 2;                       // worker threads = cores used by heavy calls
-  int max_admitted_calls = 16;           // running + queued; more -> RESOURCE_EXHAUSTED
+  int threads = 2;              // worker threads = cores used by heavy calls
+  int max_admitted_calls = 16;  // running + queued; more -> RESOURCE_EXHAUSTED
   std::size_t mesh_cache_bytes = std::size_t{512} << 20;
-  std::string auth_token;                // empty = no bearer-token check
+  std::string auth_token;  // empty = no bearer-token check
   bool json_logs = false;
 };
 

@@ -27,28 +27,40 @@ int main(int argc, char** argv) {
   uint64_t mesh_cache_mb = 512;
   CLI::App app{"surfinspectd: the surfinspect gRPC inspection service (stateless; mm)"};
   app.add_option("--listen", o.listen, "host:port (port 0 = any free port)")
-      ->envname("SURFINSPECT_LISTEN")->capture_default_str();
+      ->envname("SURFINSPECT_LISTEN")
+      ->capture_default_str();
   app.add_option("--metrics-listen", o.metrics_listen, "Prometheus /metrics host:port; empty = off")
       ->envname("SURFINSPECT_METRICS_LISTEN");
   app.add_option("--threads", o.service.threads, "worker threads for heavy calls")
-      ->envname("SURFINSPECT_THREADS")->check(CLI::Range(1, 1024))->capture_default_str();
+      ->envname("SURFINSPECT_THREADS")
+      ->check(CLI::Range(1, 1024))
+      ->capture_default_str();
   app.add_option("--max-calls", o.service.max_admitted_calls,
                  "heavy calls admitted at once (running + queued); more get RESOURCE_EXHAUSTED")
-      ->envname("SURFINSPECT_MAX_CALLS")->check(CLI::Range(1, 100000))->capture_default_str();
+      ->envname("SURFINSPECT_MAX_CALLS")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
   app.add_option("--max-points", o.service.limits.max_points, "points per cloud / per part")
-      ->envname("SURFINSPECT_MAX_POINTS")->capture_default_str();
+      ->envname("SURFINSPECT_MAX_POINTS")
+      ->capture_default_str();
   app.add_option("--max-triangles", o.service.limits.max_triangles, "triangles per mesh")
-      ->envname("SURFINSPECT_MAX_TRIANGLES")->capture_default_str();
+      ->envname("SURFINSPECT_MAX_TRIANGLES")
+      ->capture_default_str();
   app.add_option("--max-message-mb", o.max_message_mb, "largest gRPC message, MiB")
-      ->envname("SURFINSPECT_MAX_MESSAGE_MB")->capture_default_str();
+      ->envname("SURFINSPECT_MAX_MESSAGE_MB")
+      ->capture_default_str();
   app.add_option("--mesh-cache-mb", mesh_cache_mb, "mesh index cache budget, MiB")
-      ->envname("SURFINSPECT_MESH_CACHE_MB")->capture_default_str();
+      ->envname("SURFINSPECT_MESH_CACHE_MB")
+      ->capture_default_str();
   app.add_option("--drain-seconds", o.drain_seconds, "graceful shutdown deadline")
-      ->envname("SURFINSPECT_DRAIN_SECONDS")->capture_default_str();
+      ->envname("SURFINSPECT_DRAIN_SECONDS")
+      ->capture_default_str();
   app.add_option("--max-connection-age", o.max_connection_age_s,
                  "seconds before a connection is recycled (client re-balancing); 0 = never")
-      ->envname("SURFINSPECT_MAX_CONNECTION_AGE")->capture_default_str();
-  app.add_option("--tls-cert", o.tls_cert_file, "PEM certificate chain")->envname("SURFINSPECT_TLS_CERT");
+      ->envname("SURFINSPECT_MAX_CONNECTION_AGE")
+      ->capture_default_str();
+  app.add_option("--tls-cert", o.tls_cert_file, "PEM certificate chain")
+      ->envname("SURFINSPECT_TLS_CERT");
   app.add_option("--tls-key", o.tls_key_file, "PEM private key")->envname("SURFINSPECT_TLS_KEY");
   app.add_option("--tls-client-ca", o.tls_client_ca_file, "PEM CA for client certificates (mTLS)")
       ->envname("SURFINSPECT_TLS_CLIENT_CA");

@@ -43,7 +43,8 @@ absl::StatusOr<std::unique_ptr<Metrics>> Metrics::Create(const std::string& list
       m->exposer_ = std::make_unique<prometheus::Exposer>(listen, 1);
       m->exposer_->RegisterCollectable(m->registry_);
     } catch (const std::exception& e) {
-      return absl::UnavailableError(absl::StrCat("metrics: cannot listen on ", listen, ": ", e.what()));
+      return absl::UnavailableError(
+          absl::StrCat("metrics: cannot listen on ", listen, ": ", e.what()));
     }
   }
   return m;
@@ -55,8 +56,8 @@ void Metrics::RecordRpc(const std::string& method, const std::string& code, doub
   rpcs_->Add({{"method", method}, {"code", code}}).Increment();
   latency_
       ->Add({{"method", method}},
-            prometheus::Histogram::BucketBoundaries{0.001, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25,
-                                                    0.5, 1, 2.5, 5, 10, 30})
+            prometheus::Histogram::BucketBoundaries{0.001, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5,
+                                                    1, 2.5, 5, 10, 30})
       .Observe(seconds);
 }
 

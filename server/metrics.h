@@ -13,7 +13,8 @@ class Registry;
 class Exposer;
 class Counter;
 class Gauge;
-template <typename T> class Family;
+template <typename T>
+class Family;
 class Histogram;
 }  // namespace prometheus
 

@@ -83,11 +83,12 @@ absl::Status RunServer(const ServerOptions& o) {
   const std::string host = o.listen.substr(0, o.listen.rfind(':'));
   std::printf("surfinspectd listening on %s:%d\n", host.c_str(), port);
   std::fflush(stdout);
-  spdlog::info("serving on {}:{} ({} worker threads, {} admitted calls, TLS {}, token {}, metrics {})",
-               host, port, o.service.threads, o.service.max_admitted_calls,
-               o.tls_cert_file.empty() ? "off" : (o.tls_client_ca_file.empty() ? "on" : "mTLS"),
-               o.service.auth_token.empty() ? "off" : "on",
-               o.metrics_listen.empty() ? "off" : o.metrics_listen);
+  spdlog::info(
+      "serving on {}:{} ({} worker threads, {} admitted calls, TLS {}, token {}, metrics {})", host,
+      port, o.service.threads, o.service.max_admitted_calls,
+      o.tls_cert_file.empty() ? "off" : (o.tls_client_ca_file.empty() ? "on" : "mTLS"),
+      o.service.auth_token.empty() ? "off" : "on",
+      o.metrics_listen.empty() ? "off" : o.metrics_listen);
 
   std::thread waiter([&] {
     int sig = 0;

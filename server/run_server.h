@@ -12,8 +12,8 @@
 namespace surfinspect::server {
 
 struct ServerOptions {
-  std::string listen = "127.0.0.1:50051";   // host:port; port 0 picks a free one
-  std::string metrics_listen;               // e.g. 127.0.0.1:9464; empty = off
+  std::string listen = "127.0.0.1:50051";  // host:port; port 0 picks a free one
+  std::string metrics_listen;              // e.g. 127.0.0.1:9464; empty = off
   ServiceConfig service;
   std::string tls_cert_file, tls_key_file;  // both set = TLS
   std::string tls_client_ca_file;           // set = mTLS (client certificates required)

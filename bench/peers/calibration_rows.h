@@ -54,7 +54,8 @@ inline Sample SampleMesh(const TriangleMesh& m, double density_per_mm2, uint64_t
   std::uniform_real_distribution<double> u01(0, 1);
   Sample s;
   for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t k = std::size_t(std::lower_bound(cum.begin(), cum.end(), u01(rng) * area) - cum.begin());
+    const std::size_t k =
+        std::size_t(std::lower_bound(cum.begin(), cum.end(), u01(rng) * area) - cum.begin());
     const auto& t = m.triangles[std::min(k, m.triangles.size() - 1)];
     const Eigen::Vector3d a = m.vertices[t[0]].cast<double>(), b = m.vertices[t[1]].cast<double>(),
                           c = m.vertices[t[2]].cast<double>();
@@ -119,7 +120,8 @@ inline PeerResult PclPointToPlane(const std::vector<Eigen::Vector3f>& src, const
     return q;
   };
   for (const auto& p : src) s->push_back(make(p, Eigen::Vector3f::Zero()));
-  for (std::size_t i = 0; i < tgt.points.size(); ++i) t->push_back(make(tgt.points[i], tgt.normals[i]));
+  for (std::size_t i = 0; i < tgt.points.size(); ++i)
+    t->push_back(make(tgt.points[i], tgt.normals[i]));
   PeerResult r;
   r.seconds = MedianSeconds(1, false, [&] {
     pcl::IterativeClosestPointWithNormals<P, P> icp;  // point-to-plane LLS on the target normals
@@ -148,9 +150,9 @@ inline PeerResult Open3dPointToPlane(const std::vector<Eigen::Vector3f>& src, co
   }
   PeerResult r;
   r.seconds = MedianSeconds(1, false, [&] {
-    const reg::RegistrationResult res =
-        reg::RegistrationICP(s, t, gate_mm, init.matrix(), reg::TransformationEstimationPointToPlane(),
-                             reg::ICPConvergenceCriteria(1e-10, 1e-10, 100));
+    const reg::RegistrationResult res = reg::RegistrationICP(
+        s, t, gate_mm, init.matrix(), reg::TransformationEstimationPointToPlane(),
+        reg::ICPConvergenceCriteria(1e-10, 1e-10, 100));
     r.gauge_from_sensor.matrix() = res.transformation_;
   });
   return r;
@@ -165,14 +167,17 @@ inline void AddCalibrationRows(std::vector<Row>& rows) {
   const DemoViewpoint& vp = cell.viewpoints[0];
   ScanOptions opt;
   opt.noise_sigma_mm = 0.015;
-  auto scan = SimulateScan(cell.gauge, vp.world_from_gauge, vp.world_from_sensor, cell.intrinsics, opt);
+  auto scan =
+      SimulateScan(cell.gauge, vp.world_from_gauge, vp.world_from_sensor, cell.intrinsics, opt);
   if (!scan.ok()) {
-    rows.push_back({"ICP calibration", "failed: " + std::string(scan.status().message()), "", "", "", "", ""});
+    rows.push_back(
+        {"ICP calibration", "failed: " + std::string(scan.status().message()), "", "", "", "", ""});
     return;
   }
   const PointCloud& cloud = scan->cloud_in_sensor;
-  const Eigen::Isometry3d truth = vp.world_from_gauge.inverse() * vp.world_from_sensor;  // gauge_from_sensor
-  const Sample target = SampleMesh(cell.gauge, 8.0, 5);  // ~0.35 mm spacing
+  const Eigen::Isometry3d truth =
+      vp.world_from_gauge.inverse() * vp.world_from_sensor;  // gauge_from_sensor
+  const Sample target = SampleMesh(cell.gauge, 8.0, 5);      // ~0.35 mm spacing
   const std::vector<Eigen::Vector3f> source = Subsample(cloud, 40000, 9);
 
   Eigen::Isometry3d small = Eigen::Isometry3d::Identity();
@@ -200,18 +205,21 @@ inline void AddCalibrationRows(std::vector<Row>& rows) {
       if (ok) ours = *r;
     });
     const std::string ours_err = ok ? PoseError(truth, ours.gauge_from_sensor) : "failed";
-    auto add = [&](const std::string& peer_name, const std::string& peer_time, const std::string& ratio,
-                   const std::string& peer_err) {
-      rows.push_back({"ICP calibration, gauge scan, " + c.name + " (" + start + ") vs " + peer_name,
-                      Time(t_ours), peer_time, ratio,
-                      "pose error: ours " + ours_err + ", peer " + peer_err,
-                      "≤ 0.5 s (ours, incl. filter + coarse search)", Verdict(ok && t_ours <= 0.5)});
+    auto add = [&](const std::string& peer_name, const std::string& peer_time,
+                   const std::string& ratio, const std::string& peer_err) {
+      rows.push_back(
+          {"ICP calibration, gauge scan, " + c.name + " (" + start + ") vs " + peer_name,
+           Time(t_ours), peer_time, ratio, "pose error: ours " + ours_err + ", peer " + peer_err,
+           "≤ 0.5 s (ours, incl. filter + coarse search)", Verdict(ok && t_ours <= 0.5)});
     };
     auto add_peer = [&](const std::string& name, const PeerResult& p) {
-      add(name, Time(p.seconds), Fmt("%.1fx", p.seconds / t_ours), PoseError(truth, p.gauge_from_sensor));
+      add(name, Time(p.seconds), Fmt("%.1fx", p.seconds / t_ours),
+          PoseError(truth, p.gauge_from_sensor));
     };
-    add_peer("PCL ICP point-to-point", PclPointToPoint(source, target, c.init_gauge_from_sensor, c.gate_mm));
-    add_peer("PCL ICP point-to-plane", PclPointToPlane(source, target, c.init_gauge_from_sensor, c.gate_mm));
+    add_peer("PCL ICP point-to-point",
+             PclPointToPoint(source, target, c.init_gauge_from_sensor, c.gate_mm));
+    add_peer("PCL ICP point-to-plane",
+             PclPointToPlane(source, target, c.init_gauge_from_sensor, c.gate_mm));
 #ifdef SURFINSPECT_HAVE_OPEN3D
     add_peer("Open3D ICP point-to-plane",
              Open3dPointToPlane(source, target, c.init_gauge_from_sensor, c.gate_mm));

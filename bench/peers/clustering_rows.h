@@ -41,8 +41,8 @@ inline PointCloud DemoScan(uint32_t width, uint32_t height) {
   opt.noise_sigma_mm = 0.015;
   opt.pulse_fraction = 0.003;
   opt.stripes = true;
-  auto scan = SimulateScan(cell.part, cell.world_from_part, cell.viewpoints[2].world_from_sensor,
-                           in, opt);
+  auto scan =
+      SimulateScan(cell.part, cell.world_from_part, cell.viewpoints[2].world_from_sensor, in, opt);
   if (!scan.ok()) return {};
   return std::move(scan->cloud_in_sensor);
 }
@@ -140,9 +140,8 @@ inline void AddClusteringRows(std::vector<Row>& rows) {
 
   // PCL ECE on the same scan's valid points (slow: once).
   std::vector<int64_t> ece_scan;
-  const double pcl_ece_scan = MedianSeconds(1, false, [&] {
-    ece_scan = EceLabels(pcl_scan_points, settings.link_distance_mm);
-  });
+  const double pcl_ece_scan = MedianSeconds(
+      1, false, [&] { ece_scan = EceLabels(pcl_scan_points, settings.link_distance_mm); });
   LinkClusteringResult ru_scan;
   (void)ClusterLinksUnorganized(scan_points, settings, ru_scan);
   const std::size_t diff_ece_scan = PartitionDifferences(ru_scan.labels, ece_scan);
@@ -152,15 +151,16 @@ inline void AddClusteringRows(std::vector<Row>& rows) {
   // Two goals from issue 4 on this row: the absolute time and the ratio to
   // the faster of the two PCL methods (measured here, not assumed).
   const bool fast = ours8 <= 5e-3, far_ahead = ratio_scan >= 20;
-  rows.push_back({"Link clustering, 1024x768 organized scan (ours: grid, 8-nb, 1 core)", Time(ours8),
-                  Time(pcl_org) + " (PCL OrganizedConnectedComponentSegmentation, 4-nb)",
-                  Fmt("%.1fx", pcl_org / ours8),
-                  "ours 4-nb (" + Time(ours4) + ") vs PCL: " +
-                      AgreementText(diff_org, r4.valid_points),
-                  "≤ 5 ms on one core; ≥ 20x the faster PCL method",
-                  Verdict(fast) + " (" + Time(ours8) + "); " + Verdict(far_ahead) +
-                      Fmt(" (%.1fx)", ratio_scan)});
-  rows.push_back({"Link clustering, the same scan's valid points, unorganized", Time(ours8) + " (grid path)",
+  rows.push_back(
+      {"Link clustering, 1024x768 organized scan (ours: grid, 8-nb, 1 core)", Time(ours8),
+       Time(pcl_org) + " (PCL OrganizedConnectedComponentSegmentation, 4-nb)",
+       Fmt("%.1fx", pcl_org / ours8),
+       "ours 4-nb (" + Time(ours4) + ") vs PCL: " + AgreementText(diff_org, r4.valid_points),
+       "≤ 5 ms on one core; ≥ 20x the faster PCL method",
+       Verdict(fast) + " (" + Time(ours8) + "); " + Verdict(far_ahead) +
+           Fmt(" (%.1fx)", ratio_scan)});
+  rows.push_back({"Link clustering, the same scan's valid points, unorganized",
+                  Time(ours8) + " (grid path)",
                   Time(pcl_ece_scan) + " (PCL EuclideanClusterExtraction, kd-tree build included)",
                   Fmt("%.1fx", pcl_ece_scan / ours8),
                   "our voxel path vs ECE: " + AgreementText(diff_ece_scan, ru_scan.valid_points),
@@ -174,8 +174,9 @@ inline void AddClusteringRows(std::vector<Row>& rows) {
       3, false, [&] { (void)ClusterLinksUnorganized(million, settings, ru); },
       [&] { ece = EceLabels(pcl_million, settings.link_distance_mm); });
   const double ratio_u = pcl_ece / ours_u;
-  rows.push_back({"Link clustering, 10^6 unorganized points (ours: voxel path, 1 core)", Time(ours_u),
-                  Time(pcl_ece) + " (PCL ECE, kd-tree build included)", Fmt("%.1fx", ratio_u),
+  rows.push_back({"Link clustering, 10^6 unorganized points (ours: voxel path, 1 core)",
+                  Time(ours_u), Time(pcl_ece) + " (PCL ECE, kd-tree build included)",
+                  Fmt("%.1fx", ratio_u),
                   AgreementText(PartitionDifferences(ru.labels, ece), ru.valid_points),
                   "≥ 20x the faster PCL method", Verdict(ratio_u >= 20)});
 }

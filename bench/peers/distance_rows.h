@@ -56,7 +56,8 @@ inline PointCloud RasterPoints(uint32_t side, uint64_t seed) {
   for (uint32_t r = 0; r < side; ++r)
     for (uint32_t k = 0; k < side; ++k)
       c.points[std::size_t(r) * side + k] =
-          TorusPoint(2 * M_PI * (k + 0.5) / side, 2 * M_PI * (r + 0.5) / side, off(rng)).cast<float>();
+          TorusPoint(2 * M_PI * (k + 0.5) / side, 2 * M_PI * (r + 0.5) / side, off(rng))
+              .cast<float>();
   return c;
 }
 
@@ -73,8 +74,9 @@ inline PointCloud RandomPoints(std::size_t n, uint64_t seed) {
 
 inline void OurDistances(const MeshIndex& index, const PointCloud& pts, std::vector<float>& out) {
   out.assign(pts.size(), NAN);
-  (void)QueryClosestEach(index, pts, Eigen::Isometry3d::Identity(), {}, nullptr,
-                         [&](std::size_t i, const ClosestPoint& c) { out[i] = float(c.distance_mm); });
+  (void)QueryClosestEach(
+      index, pts, Eigen::Isometry3d::Identity(), {}, nullptr,
+      [&](std::size_t i, const ClosestPoint& c) { out[i] = float(c.distance_mm); });
 }
 
 #ifdef SURFINSPECT_HAVE_OPEN3D
@@ -146,8 +148,12 @@ inline void AddDistanceRows(std::vector<Row>& rows, std::vector<ScalingRow>& sca
 #endif
     Row row{std::string("Closest-point distances, 10^6 near-surface points, 150k triangles, ") +
                 (scan ? "scan order" : "random order") + " (2 threads)",
-            Time(t_ours) + Fmt(" (%.2f M pts/s)", 1e-6 * which->size() / t_ours), kNoOpen3d, "—",
-            "—", "≥ 5x Open3D throughput", "—"};
+            Time(t_ours) + Fmt(" (%.2f M pts/s)", 1e-6 * which->size() / t_ours),
+            kNoOpen3d,
+            "—",
+            "—",
+            "≥ 5x Open3D throughput",
+            "—"};
 #ifdef SURFINSPECT_HAVE_OPEN3D
     row.peer = Time(t_peer) + " (Open3D ComputeDistance)";
     row.ratio = Fmt("%.1fx", t_peer / t_ours);
@@ -171,8 +177,9 @@ inline void AddDistanceRows(std::vector<Row>& rows, std::vector<ScalingRow>& sca
 #else
     t_ours = MedianSeconds(reps, false, [&] { OurDistances(**index, pts, ours); });
 #endif
-    ScalingRow row{Fmt("distances, 10^%.0f points (random order), 150k triangles", std::log10(double(n))),
-                   Time(t_ours) + Fmt(" (%.0f ns/pt)", 1e9 * t_ours / n), kNoOpen3d, ""};
+    ScalingRow row{
+        Fmt("distances, 10^%.0f points (random order), 150k triangles", std::log10(double(n))),
+        Time(t_ours) + Fmt(" (%.0f ns/pt)", 1e9 * t_ours / n), kNoOpen3d, ""};
 #ifdef SURFINSPECT_HAVE_OPEN3D
     row.peer = Time(t_peer) + Fmt(" (%.0f ns/pt)", 1e9 * t_peer / n);
     row.note = Fmt("Open3D / ours %.1fx", t_peer / t_ours) +
@@ -195,7 +202,8 @@ inline void AddDistanceRows(std::vector<Row>& rows, std::vector<ScalingRow>& sca
       build = (*idx)->info().build_seconds;
       return MedianSeconds(3, true, [&] { OurDistances(**idx, pts, ours); });
     }();
-    ScalingRow row{Fmt("distances, 10^5 points, %.0f triangles (BVH build, then query)", double(m.num_triangles())),
+    ScalingRow row{Fmt("distances, 10^5 points, %.0f triangles (BVH build, then query)",
+                       double(m.num_triangles())),
                    "build " + Time(build) + ", query " + Time(t_query), kNoOpen3d, ""};
 #ifdef SURFINSPECT_HAVE_OPEN3D
     double t_build_peer = 0, t_peer = 0;

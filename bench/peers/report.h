@@ -61,11 +61,11 @@ inline std::string Time(double s) {
 struct Row {
   std::string what;
   std::string ours;
-  std::string peer;        // "skipped (...)" when the peer is not installed
-  std::string ratio;       // peer time / our time, or "—"
+  std::string peer;   // "skipped (...)" when the peer is not installed
+  std::string ratio;  // peer time / our time, or "—"
   std::string agreement;
-  std::string goal;        // as stated in the row's issue
-  std::string met;         // "met" / "**not met**" / "—"
+  std::string goal;  // as stated in the row's issue
+  std::string met;   // "met" / "**not met**" / "—"
 };
 
 inline std::string Verdict(bool met) { return met ? "met" : "**not met**"; }
@@ -108,8 +108,8 @@ inline std::string RenderRows(const std::vector<Row>& rows) {
   std::vector<std::vector<std::string>> cells;
   for (const Row& r : rows)
     cells.push_back({r.what, r.ours, r.peer, r.ratio, r.agreement, r.goal, r.met});
-  return MarkdownTable({"Comparison", "Ours", "Peer", "Peer / ours", "Agreement", "Goal", "Goal met"},
-                       cells);
+  return MarkdownTable(
+      {"Comparison", "Ours", "Peer", "Peer / ours", "Agreement", "Goal", "Goal met"}, cells);
 }
 
 inline std::string RenderScaling(const std::vector<ScalingRow>& rows) {

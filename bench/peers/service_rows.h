@@ -27,7 +27,6 @@ namespace surfinspect::bench {
 
 namespace service_detail {
 
-
 // Seconds from the view header to STAGE_VIEW_RECEIVED; NaN on failure.
 inline double StreamOnce(v1::InspectionService::Stub& stub, const v1::InspectRequest& part,
                          const v1::InspectRequest& view, const std::string& bytes) {
@@ -38,7 +37,8 @@ inline double StreamOnce(v1::InspectionService::Stub& stub, const v1::InspectReq
   stream->Write(view);
   v1::InspectRequest chunk;
   for (std::size_t off = 0; off < bytes.size(); off += 1 << 20) {
-    chunk.mutable_chunk()->set_xyz(bytes.data() + off, std::min<std::size_t>(1 << 20, bytes.size() - off));
+    chunk.mutable_chunk()->set_xyz(bytes.data() + off,
+                                   std::min<std::size_t>(1 << 20, bytes.size() - off));
     stream->Write(chunk);
   }
   v1::InspectResponse resp;
@@ -76,7 +76,8 @@ inline void AddServiceRows(std::vector<Row>& rows) {
   const DemoViewpoint& vp = cell.viewpoints[2];
   ScanOptions opt;
   opt.noise_sigma_mm = 0.015;
-  auto scan = SimulateScan(cell.part, cell.world_from_part, vp.world_from_sensor, cell.intrinsics, opt);
+  auto scan =
+      SimulateScan(cell.part, cell.world_from_part, vp.world_from_sensor, cell.intrinsics, opt);
   auto index = MeshIndex::Build(cell.part);
   testing::ServerProcess server;
   client::RemoteOptions o;
@@ -117,13 +118,14 @@ inline void AddServiceRows(std::vector<Row>& rows) {
     if (!(d == l || (std::isnan(d) && std::isnan(l)))) ++differ;
   }
   const double ratio = t_remote / t_local;
-  rows.push_back({"Service: ErrorMap of a 1024x768 scan, gRPC loopback vs in-process", Time(t_local),
-                  remote_ok ? Time(t_remote) + " (via surfinspectd)" : "failed",
-                  Fmt("%.2fx", ratio),
-                  !sized ? "deviations missing"
-                         : differ == 0 ? "identical deviations (" + std::to_string(local.deviation_mm.size()) + " points)"
-                                       : std::to_string(differ) + " deviations differ",
-                  "≤ 1.3x in-process", Verdict(remote_ok && ratio <= 1.3)});
+  rows.push_back(
+      {"Service: ErrorMap of a 1024x768 scan, gRPC loopback vs in-process", Time(t_local),
+       remote_ok ? Time(t_remote) + " (via surfinspectd)" : "failed", Fmt("%.2fx", ratio),
+       !sized ? "deviations missing"
+       : differ == 0
+           ? "identical deviations (" + std::to_string(local.deviation_mm.size()) + " points)"
+           : std::to_string(differ) + " deviations differ",
+       "≤ 1.3x in-process", Verdict(remote_ok && ratio <= 1.3)});
 
   // Streaming one view.
   auto stub = v1::InspectionService::NewStub(
@@ -136,7 +138,8 @@ inline void AddServiceRows(std::vector<Row>& rows) {
   view.mutable_view()->set_name("v");
   view.mutable_view()->set_width(cloud.width);
   view.mutable_view()->set_height(cloud.height);
-  wire::TransformToProto(Eigen::Isometry3d::Identity(), view.mutable_view()->mutable_world_from_sensor());
+  wire::TransformToProto(Eigen::Isometry3d::Identity(),
+                         view.mutable_view()->mutable_world_from_sensor());
   double t_stream = NAN;
   std::vector<double> times;
   service_detail::StreamOnce(*stub, part, view, raw);  // warm-up
@@ -149,10 +152,11 @@ inline void AddServiceRows(std::vector<Row>& rows) {
   std::sort(times.begin(), times.end());
   if (all_received) t_stream = times[times.size() / 2];
   const double mb = raw.size() / 1e6;
-  rows.push_back({Fmt("Service: stream one %.1f MB view in 1 MB chunks until received", mb),
-                  std::isnan(t_stream) ? "failed" : Time(t_stream) + Fmt(" (%.0f MB/s)", mb / t_stream),
-                  "none", "—", "server reported STAGE_VIEW_RECEIVED", "≤ 15 ms",
-                  Verdict(!std::isnan(t_stream) && t_stream <= 15e-3)});
+  rows.push_back(
+      {Fmt("Service: stream one %.1f MB view in 1 MB chunks until received", mb),
+       std::isnan(t_stream) ? "failed" : Time(t_stream) + Fmt(" (%.0f MB/s)", mb / t_stream),
+       "none", "—", "server reported STAGE_VIEW_RECEIVED", "≤ 15 ms",
+       Verdict(!std::isnan(t_stream) && t_stream <= 15e-3)});
 }
 
 }  // namespace surfinspect::bench

@@ -39,13 +39,15 @@ absl::Status MovePart(const std::string& inbox, const std::string& dest, const s
   fs::path target = fs::path(dest) / id;
   for (int n = 1; fs::exists(target); ++n) target = fs::path(dest) / absl::StrCat(id, ".", n);
   fs::rename(fs::path(inbox) / id, target, ec);
-  if (ec) return absl::InternalError(absl::StrCat("cannot move ", id, " to ", dest, ": ", ec.message()));
+  if (ec)
+    return absl::InternalError(absl::StrCat("cannot move ", id, " to ", dest, ": ", ec.message()));
   return absl::OkStatus();
 }
 
 absl::Status Quarantine(const InboxLayout& layout, const std::string& id, const std::string& why) {
   // error.txt goes in first, so the reason travels with the part.
-  if (auto st = WriteStringAtomically((fs::path(layout.inbox) / id / "error.txt").string(), why + "\n");
+  if (auto st =
+          WriteStringAtomically((fs::path(layout.inbox) / id / "error.txt").string(), why + "\n");
       !st.ok())
     return st;
   return MovePart(layout.inbox, layout.quarantine, id);

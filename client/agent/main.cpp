@@ -64,7 +64,8 @@ std::unique_ptr<RemoteClient> ConnectFor(const AgentArgs& a, const CellConfig& c
   o.timeout_s = a.timeout_s;
   const std::string token_file = !a.token_file.empty() ? a.token_file : cell.server.token_file;
   if (!token_file.empty())
-    o.auth_token = std::string(absl::StripAsciiWhitespace(OrDie(ReadFileToString(token_file, 4096))));
+    o.auth_token =
+        std::string(absl::StripAsciiWhitespace(OrDie(ReadFileToString(token_file, 4096))));
   if (o.target.empty()) {
     spdlog::error("no server: give --server or set server.target in {}", cell.path);
     std::exit(2);
@@ -87,9 +88,11 @@ int Calibrate(const AgentArgs& a) {
   std::vector<std::pair<std::string, nlohmann::json>> quality;
   std::mt19937_64 rng(a.seed);
   int failures = 0;
-  std::printf("%-8s %10s %12s %12s %6s %10s\n", "view", "rms_mm", "sigma_t_um", "sigma_r_deg", "iters", "degenerate");
+  std::printf("%-8s %10s %12s %12s %6s %10s\n", "view", "rms_mm", "sigma_t_um", "sigma_r_deg",
+              "iters", "degenerate");
   for (auto& vp : cell.viewpoints) {
-    const std::string scan_path = a.gauge_scans.empty() ? vp.gauge_scan : a.gauge_scans + "/" + vp.name + ".pcd";
+    const std::string scan_path =
+        a.gauge_scans.empty() ? vp.gauge_scan : a.gauge_scans + "/" + vp.name + ".pcd";
     auto scan = ReadPointCloud(scan_path);
     if (!scan.ok()) {
       spdlog::error("{}: {}", vp.name, std::string(scan.status().message()));
@@ -116,10 +119,12 @@ int Calibrate(const AgentArgs& a) {
       continue;
     }
     const v1::CalibrationQuality& q = resp->quality();
-    std::printf("%-8s %10.4f %12.2f %12.5f %6u %10s\n", vp.name.c_str(), q.rms_mm(), q.sigma_translation_um(),
-                q.sigma_rotation_deg(), q.iterations(), q.degenerate() ? "YES" : "no");
+    std::printf("%-8s %10.4f %12.2f %12.5f %6u %10s\n", vp.name.c_str(), q.rms_mm(),
+                q.sigma_translation_um(), q.sigma_rotation_deg(), q.iterations(),
+                q.degenerate() ? "YES" : "no");
     for (const auto& w : q.warnings()) spdlog::warn("{}: {}", vp.name, w);
-    vp.world_from_sensor = OrDie(wire::TransformFromProto(resp->world_from_sensor(), "world_from_sensor"));
+    vp.world_from_sensor =
+        OrDie(wire::TransformFromProto(resp->world_from_sensor(), "world_from_sensor"));
     quality.emplace_back(vp.name, nlohmann::json{{"rms_mm", q.rms_mm()},
                                                  {"sigma_translation_um", q.sigma_translation_um()},
                                                  {"sigma_rotation_deg", q.sigma_rotation_deg()},
@@ -176,18 +181,22 @@ PartOutcome ProcessPart(const AgentArgs& a, const CellConfig& cell, const Triang
     Quarantine(layout, id, "no <viewpoint>.pcd scan of this cell's viewpoints").IgnoreError();
     return PartOutcome::kQuarantined;
   }
-  const v1::PartHeader header = MakePartHeader(id, cell.world_from_part, InspectionSettingsOf(cell));
+  const v1::PartHeader header =
+      MakePartHeader(id, cell.world_from_part, InspectionSettingsOf(cell));
   const bool tty = isatty(STDERR_FILENO);
   absl::StatusOr<v1::InspectResult> result;
   for (int attempt = 0;; ++attempt) {
     result = client.Inspect(header, part, views, [&](const v1::Progress& p) {
-      if (tty) std::fprintf(stderr, "\r  %s: %-24s %-6s      ", id.c_str(), v1::Progress::Stage_Name(p.stage()).c_str(), p.view().c_str());
+      if (tty)
+        std::fprintf(stderr, "\r  %s: %-24s %-6s      ", id.c_str(),
+                     v1::Progress::Stage_Name(p.stage()).c_str(), p.view().c_str());
     });
     if (tty) std::fprintf(stderr, "\r%*s\r", 60, "");
     if (result.ok() || !IsRetryable(result.status())) break;
     if (g_stop.load()) return PartOutcome::kRetryLater;
     if (a.max_attempts > 0 && attempt + 1 >= a.max_attempts) return PartOutcome::kRetryLater;
-    spdlog::warn("{}: {} (attempt {}, retrying)", id, std::string(result.status().message()), attempt + 1);
+    spdlog::warn("{}: {} (attempt {}, retrying)", id, std::string(result.status().message()),
+                 attempt + 1);
     Backoff(a, attempt, rng);
   }
   if (!result.ok()) {
@@ -198,16 +207,18 @@ PartOutcome ProcessPart(const AgentArgs& a, const CellConfig& cell, const Triang
     return PartOutcome::kQuarantined;
   }
   auto outputs = OutputsFromRemote(*result);
-  absl::Status written = outputs.ok() ? WritePartOutputs(layout.results + "/" + id, *outputs) : outputs.status();
+  absl::Status written =
+      outputs.ok() ? WritePartOutputs(layout.results + "/" + id, *outputs) : outputs.status();
   if (!written.ok()) {  // disk trouble: keep the part in the inbox for the next pass
     spdlog::error("{}: cannot write results: {}", id, std::string(written.message()));
     return PartOutcome::kRetryLater;
   }
-  if (auto st = MovePart(layout.inbox, layout.archive, id); !st.ok()) spdlog::error("{}", std::string(st.message()));
+  if (auto st = MovePart(layout.inbox, layout.archive, id); !st.ok())
+    spdlog::error("{}", std::string(st.message()));
   *passed = outputs->verdict == "pass";
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::printf("%-16s %-4s  max %+.3f mm  min %+.3f mm  %.1f s\n", id.c_str(), outputs->verdict.c_str(),
-              outputs->max_mm, outputs->min_mm, s);
+  std::printf("%-16s %-4s  max %+.3f mm  min %+.3f mm  %.1f s\n", id.c_str(),
+              outputs->verdict.c_str(), outputs->max_mm, outputs->min_mm, s);
   std::fflush(stdout);
   return PartOutcome::kDone;
 }
@@ -248,8 +259,9 @@ int Run(const AgentArgs& a) {
       for (double t = 0; t < a.poll_s && !g_stop.load(); t += 0.05)
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
-  std::printf("summary: %d parts done (%d pass, %d fail), %d quarantined, %zu left in %s\n", done, pass,
-              done - pass, quarantined, CompleteParts(layout.inbox).size(), layout.inbox.c_str());
+  std::printf("summary: %d parts done (%d pass, %d fail), %d quarantined, %zu left in %s\n", done,
+              pass, done - pass, quarantined, CompleteParts(layout.inbox).size(),
+              layout.inbox.c_str());
   return quarantined == 0 ? 0 : 3;
 }
 
@@ -260,11 +272,15 @@ void AddConnection(CLI::App* cmd, AgentArgs& a) {
   cmd->add_option("--tls-ca", a.tls_ca, "PEM CA of the server certificate (enables TLS)");
   cmd->add_option("--tls-cert", a.tls_cert, "client certificate (mTLS)");
   cmd->add_option("--tls-key", a.tls_key, "client key (mTLS)");
-  cmd->add_option("--token-file", a.token_file, "bearer token file")->envname("SURFINSPECT_TOKEN_FILE");
+  cmd->add_option("--token-file", a.token_file, "bearer token file")
+      ->envname("SURFINSPECT_TOKEN_FILE");
   cmd->add_option("--timeout", a.timeout_s, "per-call deadline, s")->check(CLI::PositiveNumber);
-  cmd->add_option("--max-attempts", a.max_attempts, "per part/view on retryable errors; 0 = unlimited");
-  cmd->add_option("--backoff", a.backoff_initial_s, "first retry delay, s")->check(CLI::PositiveNumber);
-  cmd->add_option("--backoff-max", a.backoff_max_s, "longest retry delay, s")->check(CLI::PositiveNumber);
+  cmd->add_option("--max-attempts", a.max_attempts,
+                  "per part/view on retryable errors; 0 = unlimited");
+  cmd->add_option("--backoff", a.backoff_initial_s, "first retry delay, s")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--backoff-max", a.backoff_max_s, "longest retry delay, s")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--seed", a.seed, "random seed (simulation, jitter)");
 }
 
@@ -278,16 +294,21 @@ int main(int argc, char** argv) {
   AgentArgs a;
   CLI::App app{"cell-agent: streams a robot cell's scans to surfinspectd and keeps the results"};
   app.require_subcommand(1);
-  auto* cal = app.add_subcommand("calibrate", "Calibrate every viewpoint from its gauge scan; update cell.json");
+  auto* cal = app.add_subcommand("calibrate",
+                                 "Calibrate every viewpoint from its gauge scan; update cell.json");
   AddConnection(cal, a);
-  cal->add_option("--gauge-scans", a.gauge_scans, "folder of <viewpoint>.pcd (default: gauge_scan in cell.json)");
+  cal->add_option("--gauge-scans", a.gauge_scans,
+                  "folder of <viewpoint>.pcd (default: gauge_scan in cell.json)");
   auto* run = app.add_subcommand("run", "Process complete parts from the inbox");
   AddConnection(run, a);
   run->add_option("--inbox", a.inbox, "where the scanner drops <part-id>/<viewpoint>.pcd + DONE");
-  run->add_option("--results", a.results, "results/<part-id>/{report.json,errormap.ply,errormap.png,deviations.csv}");
+  run->add_option("--results", a.results,
+                  "results/<part-id>/{report.json,errormap.ply,errormap.png,deviations.csv}");
   run->add_option("--archive", a.archive, "processed scans (default: archive)");
-  run->add_option("--quarantine", a.quarantine, "parts that cannot succeed, with error.txt (default: quarantine)");
-  run->add_option("--simulate", a.simulate, "first drop N simulated parts into the inbox")->check(CLI::Range(0, 10000));
+  run->add_option("--quarantine", a.quarantine,
+                  "parts that cannot succeed, with error.txt (default: quarantine)");
+  run->add_option("--simulate", a.simulate, "first drop N simulated parts into the inbox")
+      ->check(CLI::Range(0, 10000));
   run->add_flag("--once", a.once, "process what is there, then exit");
   run->add_option("--poll", a.poll_s, "inbox poll interval, s")->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);

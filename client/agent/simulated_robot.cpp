@@ -13,8 +13,9 @@
 namespace surfinspect::client {
 namespace fs = std::filesystem;
 
-absl::StatusOr<std::vector<std::string>> SimulateParts(const CellConfig& cell, const std::string& inbox,
-                                                       int count, uint64_t seed) {
+absl::StatusOr<std::vector<std::string>> SimulateParts(const CellConfig& cell,
+                                                       const std::string& inbox, int count,
+                                                       uint64_t seed) {
   auto part = ReadMesh(cell.part_mesh);
   if (!part.ok()) return part.status();
   SensorIntrinsics intrinsics;
@@ -49,19 +50,22 @@ absl::StatusOr<std::vector<std::string>> SimulateParts(const CellConfig& cell, c
       defect.depth_mm = (d == 1 ? -1 : 1) * udepth(rng);
       double top = b.max.z();
       for (const auto& t : part->triangles) {  // highest facet above (x, y)
-        const Eigen::Vector3d a = part->vertices[t[0]].cast<double>(), bb = part->vertices[t[1]].cast<double>(),
+        const Eigen::Vector3d a = part->vertices[t[0]].cast<double>(),
+                              bb = part->vertices[t[1]].cast<double>(),
                               c = part->vertices[t[2]].cast<double>();
         const Eigen::Vector3d n = (bb - a).cross(c - a);
         if (std::abs(n.z()) < 1e-9) continue;
         const double z = a.z() - (n.x() * (x - a.x()) + n.y() * (y - a.y())) / n.z();
         const Eigen::Vector3d p(x, y, z);
-        const bool inside = (bb - a).cross(p - a).z() * n.z() >= 0 && (c - bb).cross(p - bb).z() * n.z() >= 0 &&
+        const bool inside = (bb - a).cross(p - a).z() * n.z() >= 0 &&
+                            (c - bb).cross(p - bb).z() * n.z() >= 0 &&
                             (a - c).cross(p - c).z() * n.z() >= 0;
         if (inside) top = z;
       }
       defect.center_in_part = {x, y, top};
       opt.defects.push_back(defect);
-      defects.push_back({{"center_in_part", {x, y, top}}, {"radius_mm", defect.radius_mm},
+      defects.push_back({{"center_in_part", {x, y, top}},
+                         {"radius_mm", defect.radius_mm},
                          {"depth_mm", defect.depth_mm}});
     }
     const fs::path dir = fs::path(inbox) / id;
@@ -74,12 +78,14 @@ absl::StatusOr<std::vector<std::string>> SimulateParts(const CellConfig& cell, c
       Eigen::Isometry3d pose = vp.world_from_sensor.value_or(vp.nominal_world_from_sensor);
       for (const auto& jv : cell.raw["viewpoints"])
         if (jv.value("name", "") == vp.name && jv.contains("simulation_truth_world_from_sensor"))
-          if (auto t = TransformFromJsonValue(jv["simulation_truth_world_from_sensor"], "truth"); t.ok())
+          if (auto t = TransformFromJsonValue(jv["simulation_truth_world_from_sensor"], "truth");
+              t.ok())
             pose = *t;
       opt.seed = seed * 1000003 + n * 101 + v;
       auto scan = SimulateScan(*part, cell.world_from_part, pose, intrinsics, opt);
       if (!scan.ok()) return scan.status();
-      if (auto st = WritePointCloud((dir / (vp.name + ".pcd")).string(), scan->cloud_in_sensor); !st.ok())
+      if (auto st = WritePointCloud((dir / (vp.name + ".pcd")).string(), scan->cloud_in_sensor);
+          !st.ok())
         return st;
     }
     if (auto st = WriteStringAtomically((dir / "truth.json").string(),

@@ -13,14 +13,12 @@ absl::Status Bad(const std::string& path, absl::string_view why) {
   return absl::InvalidArgumentError(absl::StrCat(path, ": ", why));
 }
 
-
 std::string Resolve(const std::string& cell_path, const std::string& p) {
   if (p.empty() || p[0] == '/') return p;
   return (std::filesystem::path(cell_path).parent_path() / p).string();
 }
 
 }  // namespace
-
 
 absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
   auto text = ReadFileToString(path, 16 << 20);
@@ -31,10 +29,12 @@ absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
   if (c.raw.is_discarded() || !c.raw.is_object()) return Bad(path, "not a JSON object");
   const nlohmann::json& j = c.raw;
   try {
-    if (!j.contains("part") || !j["part"].contains("mesh") || !j["part"].contains("world_from_part"))
+    if (!j.contains("part") || !j["part"].contains("mesh") ||
+        !j["part"].contains("world_from_part"))
       return Bad(path, "needs part.mesh and part.world_from_part");
     c.part_mesh = Resolve(path, j["part"]["mesh"].get<std::string>());
-    auto wfp = TransformFromJsonValue(j["part"]["world_from_part"], path + ": part.world_from_part");
+    auto wfp =
+        TransformFromJsonValue(j["part"]["world_from_part"], path + ": part.world_from_part");
     if (!wfp.ok()) return wfp.status();
     c.world_from_part = *wfp;
     if (j.contains("gauge") && j["gauge"].contains("mesh"))
@@ -49,7 +49,8 @@ absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
       if (vp.name.empty() || vp.name.find('/') != std::string::npos)
         return Bad(where, "name must be non-empty and contain no '/'");
       if (v.contains("nominal_world_from_sensor")) {
-        auto t = TransformFromJsonValue(v["nominal_world_from_sensor"], where + ".nominal_world_from_sensor");
+        auto t = TransformFromJsonValue(v["nominal_world_from_sensor"],
+                                        where + ".nominal_world_from_sensor");
         if (!t.ok()) return t.status();
         vp.nominal_world_from_sensor = *t;
       }
@@ -63,21 +64,25 @@ absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
         if (!t.ok()) return t.status();
         vp.world_from_sensor = *t;
       }
-      if (v.contains("gauge_scan")) vp.gauge_scan = Resolve(path, v["gauge_scan"].get<std::string>());
+      if (v.contains("gauge_scan"))
+        vp.gauge_scan = Resolve(path, v["gauge_scan"].get<std::string>());
       c.viewpoints.push_back(vp);
     }
     if (j.contains("tolerance_mm")) c.error_map.tolerance_mm = j["tolerance_mm"].get<double>();
     if (j.contains("error_map")) {
       const auto& e = j["error_map"];
       c.error_map.max_distance_mm = e.value("max_distance_mm", c.error_map.max_distance_mm);
-      c.error_map.allowed_fraction_outside = e.value("allowed_fraction_outside", c.error_map.allowed_fraction_outside);
+      c.error_map.allowed_fraction_outside =
+          e.value("allowed_fraction_outside", c.error_map.allowed_fraction_outside);
       c.error_map.histogram_bins = e.value("histogram_bins", c.error_map.histogram_bins);
     }
     if (j.contains("filter")) {
       const auto& f = j["filter"];
       c.filter = f.value("enabled", true);
-      c.filter_settings.link_distance_mm = f.value("link_distance_mm", c.filter_settings.link_distance_mm);
-      c.filter_settings.min_cluster_points = f.value("min_cluster_points", c.filter_settings.min_cluster_points);
+      c.filter_settings.link_distance_mm =
+          f.value("link_distance_mm", c.filter_settings.link_distance_mm);
+      c.filter_settings.min_cluster_points =
+          f.value("min_cluster_points", c.filter_settings.min_cluster_points);
       c.filter_settings.connectivity = f.value("connectivity", c.filter_settings.connectivity);
     }
     if (j.contains("server")) {
@@ -92,7 +97,8 @@ absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
     return Bad(path, absl::StrCat("malformed: ", e.what()));
   }
   if (!(c.error_map.tolerance_mm > 0)) return Bad(path, "tolerance_mm must be > 0");
-  if (auto st = ValidateLinkClusteringSettings(c.filter_settings); !st.ok()) return Bad(path, st.message());
+  if (auto st = ValidateLinkClusteringSettings(c.filter_settings); !st.ok())
+    return Bad(path, st.message());
   return c;
 }
 
@@ -104,13 +110,14 @@ InspectionSettings InspectionSettingsOf(const CellConfig& cell) {
   return s;
 }
 
-absl::Status WriteCellCalibrations(const CellConfig& cell,
-                                   const std::vector<std::pair<std::string, nlohmann::json>>& quality) {
+absl::Status WriteCellCalibrations(
+    const CellConfig& cell, const std::vector<std::pair<std::string, nlohmann::json>>& quality) {
   nlohmann::json j = cell.raw;
   for (auto& v : j["viewpoints"]) {
     const std::string name = v["name"].get<std::string>();
     for (const auto& vp : cell.viewpoints)
-      if (vp.name == name && vp.world_from_sensor) v["world_from_sensor"] = TransformToJsonValue(*vp.world_from_sensor);
+      if (vp.name == name && vp.world_from_sensor)
+        v["world_from_sensor"] = TransformToJsonValue(*vp.world_from_sensor);
     for (const auto& [n, q] : quality)
       if (n == name) v["calibration"] = q;
   }

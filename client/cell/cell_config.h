@@ -29,8 +29,8 @@ struct CellViewpoint {
   std::string name;
   Eigen::Isometry3d nominal_world_from_sensor = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d world_from_gauge = Eigen::Isometry3d::Identity();
-  std::string gauge_scan;                                  // resolved path, may be empty
-  std::optional<Eigen::Isometry3d> world_from_sensor;      // calibrated
+  std::string gauge_scan;                              // resolved path, may be empty
+  std::optional<Eigen::Isometry3d> world_from_sensor;  // calibrated
 };
 
 struct CellServer {
@@ -38,7 +38,7 @@ struct CellServer {
 };
 
 struct CellConfig {
-  std::string path;                 // of cell.json
+  std::string path;                   // of cell.json
   std::string part_mesh, gauge_mesh;  // resolved paths
   Eigen::Isometry3d world_from_part = Eigen::Isometry3d::Identity();
   std::vector<CellViewpoint> viewpoints;
@@ -46,7 +46,7 @@ struct CellConfig {
   bool filter = true;
   LinkClusteringSettings filter_settings = LinkClusteringSettings::ForInspection();
   CellServer server;
-  nlohmann::json raw;               // the whole file, kept for rewriting
+  nlohmann::json raw;  // the whole file, kept for rewriting
 };
 
 absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path);
@@ -57,7 +57,7 @@ InspectionSettings InspectionSettingsOf(const CellConfig& cell);
 // Stores each calibrated viewpoint's world_from_sensor and quality (JSON)
 // into the file: the previous file is kept as cell.json.bak, the new one is
 // written to a temporary file and renamed over cell.json.
-absl::Status WriteCellCalibrations(const CellConfig& cell,
-                                   const std::vector<std::pair<std::string, nlohmann::json>>& quality);
+absl::Status WriteCellCalibrations(
+    const CellConfig& cell, const std::vector<std::pair<std::string, nlohmann::json>>& quality);
 
 }  // namespace surfinspect::client

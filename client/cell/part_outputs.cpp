@@ -52,7 +52,8 @@ absl::StatusOr<PartOutputs> OutputsFromRemote(const v1::InspectResult& r) {
   o.verdict = r.verdict();
   o.report_json = r.report_json();
   o.png = r.png();
-  auto merged = wire::CloudFromBytes(r.merged().xyz(), r.merged().width(), r.merged().height(), "merged");
+  auto merged =
+      wire::CloudFromBytes(r.merged().xyz(), r.merged().width(), r.merged().height(), "merged");
   if (!merged.ok()) return merged.status();
   o.merged_in_world = *std::move(merged);
   o.deviation_mm = wire::UnpackFloats(r.deviations());
@@ -85,8 +86,10 @@ absl::Status WritePartOutputs(const std::string& dir, const PartOutputs& o) {
   view.deviation_mm = o.deviation_mm;
   view.tolerance_mm = o.tolerance_mm;
   view.color_range_mm = o.color_range_mm;
-  if (auto st = WriteErrorMapPly(dir + "/errormap.ply", o.merged_in_world, view, "world"); !st.ok()) return st;
-  if (auto st = WriteErrorMapCsv(dir + "/deviations.csv", o.merged_in_world, view); !st.ok()) return st;
+  if (auto st = WriteErrorMapPly(dir + "/errormap.ply", o.merged_in_world, view, "world"); !st.ok())
+    return st;
+  if (auto st = WriteErrorMapCsv(dir + "/deviations.csv", o.merged_in_world, view); !st.ok())
+    return st;
   if (auto st = WriteStringAtomically(dir + "/errormap.png", o.png); !st.ok()) return st;
   // The report last: its presence means the part's results are complete.
   return WriteStringAtomically(dir + "/report.json", o.report_json);

@@ -16,7 +16,7 @@ namespace surfinspect::client {
 
 struct PartOutputs {
   std::string part_id;
-  std::string verdict;              // "pass" / "fail"
+  std::string verdict;  // "pass" / "fail"
   std::string report_json;
   std::string png;                  // PNG bytes
   PointCloud merged_in_world;       // merged, valid points

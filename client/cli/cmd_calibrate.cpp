@@ -26,22 +26,23 @@ struct CalibrateArgs {
 
 nlohmann::json QualityJson(const v1::CalibrateResponse& r) {
   const v1::CalibrationQuality& q = r.quality();
-  return {{"rms", q.rms_mm()},
-          {"iterations", q.iterations()},
-          {"converged", q.converged()},
-          {"stop_reason", q.stop_reason()},
-          {"inlier_fraction", q.inlier_fraction()},
-          {"sigma_translation_um", q.sigma_translation_um()},
-          {"sigma_rotation_deg", q.sigma_rotation_deg()},
-          {"degenerate", q.degenerate()},
-          {"degeneracy_ratio", q.degeneracy_ratio()},
-          {"residual_p50_mm", q.residual_p50_mm()},
-          {"residual_p95_mm", q.residual_p95_mm()},
-          {"residual_p99_mm", q.residual_p99_mm()},
-          {"filtered_points", q.filtered_points()},
-          {"cost_history_mm2", std::vector<double>(q.cost_history().begin(), q.cost_history().end())},
-          {"warnings", std::vector<std::string>(q.warnings().begin(), q.warnings().end())},
-          {"units", "mm"}};
+  return {
+      {"rms", q.rms_mm()},
+      {"iterations", q.iterations()},
+      {"converged", q.converged()},
+      {"stop_reason", q.stop_reason()},
+      {"inlier_fraction", q.inlier_fraction()},
+      {"sigma_translation_um", q.sigma_translation_um()},
+      {"sigma_rotation_deg", q.sigma_rotation_deg()},
+      {"degenerate", q.degenerate()},
+      {"degeneracy_ratio", q.degeneracy_ratio()},
+      {"residual_p50_mm", q.residual_p50_mm()},
+      {"residual_p95_mm", q.residual_p95_mm()},
+      {"residual_p99_mm", q.residual_p99_mm()},
+      {"filtered_points", q.filtered_points()},
+      {"cost_history_mm2", std::vector<double>(q.cost_history().begin(), q.cost_history().end())},
+      {"warnings", std::vector<std::string>(q.warnings().begin(), q.warnings().end())},
+      {"units", "mm"}};
 }
 
 }  // namespace
@@ -52,7 +53,8 @@ std::string CalibrationLine(const std::string& name, const v1::CalibrateResponse
   char buf[256];
   std::snprintf(buf, sizeof(buf), "%-8s rms %.4f mm  sigma %.2f um / %.5f deg  %s%s", name.c_str(),
                 q.rms_mm(), q.sigma_translation_um(), q.sigma_rotation_deg(),
-                q.converged() ? "converged" : "NOT converged", q.degenerate() ? "  DEGENERATE" : "");
+                q.converged() ? "converged" : "NOT converged",
+                q.degenerate() ? "  DEGENERATE" : "");
   return buf;
 }
 
@@ -61,8 +63,10 @@ void Calibrate(const CalibrateArgs& a) {
     throw CommandFailed("--point-to-point and --point-to-plane exclude each other");
   const TriangleMesh gauge = Take(ReadMesh(a.gauge));
   v1::CalibrateRequest req;
-  wire::TransformToProto(Take(ReadTransformJson(a.world_from_gauge)), req.mutable_world_from_gauge());
-  wire::TransformToProto(Take(ReadTransformJson(a.initial)), req.mutable_initial_world_from_sensor());
+  wire::TransformToProto(Take(ReadTransformJson(a.world_from_gauge)),
+                         req.mutable_world_from_gauge());
+  wire::TransformToProto(Take(ReadTransformJson(a.initial)),
+                         req.mutable_initial_world_from_sensor());
   wire::CloudToProto(Take(ReadPointCloud(a.scan)), req.mutable_scan());
   CalibrationSettings settings;
   if (a.point_to_point) settings.icp.step = IcpStep::kPointToPoint;
@@ -82,7 +86,8 @@ void Calibrate(const CalibrateArgs& a) {
     const CalibrationResult r = Take(CalibrateViewpoint(
         *index, Take(wire::TransformFromProto(req.world_from_gauge(), "world_from_gauge")),
         Take(wire::CloudFromProto(req.scan(), "scan", limits)),
-        Take(wire::TransformFromProto(req.initial_world_from_sensor(), "initial_world_from_sensor")),
+        Take(
+            wire::TransformFromProto(req.initial_world_from_sensor(), "initial_world_from_sensor")),
         settings));
     wire::CalibrationToProto(r, &resp);
   }
@@ -99,15 +104,18 @@ void AddCalibrateCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "calibrate", "Fit the gauge mesh to a gauge scan (filter + ICP) and write world_from_sensor");
   cmd->add_option("--gauge", a->gauge, "gauge mesh (gauge frame, mm)")->required();
-  cmd->add_option("--world-from-gauge", a->world_from_gauge, "surveyed gauge pose (JSON)")->required();
+  cmd->add_option("--world-from-gauge", a->world_from_gauge, "surveyed gauge pose (JSON)")
+      ->required();
   cmd->add_option("--scan", a->scan, "gauge scan (sensor frame)")->required();
-  cmd->add_option("--initial-world-from-sensor", a->initial, "robot's nominal pose (JSON)")->required();
+  cmd->add_option("--initial-world-from-sensor", a->initial, "robot's nominal pose (JSON)")
+      ->required();
   cmd->add_option("--out", a->out, "calibrated world_from_sensor (JSON)")->required();
   cmd->add_option("--report", a->report, "quality report (JSON)");
   cmd->add_flag("--point-to-plane", a->point_to_plane, "point-to-plane steps (the default)");
   cmd->add_flag("--point-to-point", a->point_to_point, "Horn's point-to-point steps (the paper's)");
   cmd->add_flag("--no-filter", a->no_filter, "skip the link-clustering filter");
-  cmd->add_option("--max-iterations", a->max_iterations, "ICP iteration cap")->check(CLI::Range(1, 10000));
+  cmd->add_option("--max-iterations", a->max_iterations, "ICP iteration cap")
+      ->check(CLI::Range(1, 10000));
   AddRemoteOptions(cmd, a->remote);
   cmd->callback([a] { Calibrate(*a); });
 }

@@ -9,7 +9,6 @@
 
 #include "client/cli/commands.h"
 #include "client/cli/remote_args.h"
-#include "proto/convert.h"
 #include "core/atomic_file.h"
 #include "core/error_map.h"
 #include "core/error_map_output.h"
@@ -19,6 +18,7 @@
 #include "core/io_transform.h"
 #include "core/mesh_index.h"
 #include "core/transform.h"
+#include "proto/convert.h"
 
 namespace surfinspect::cli {
 namespace {
@@ -62,7 +62,8 @@ void RunErrorMap(const ErrorMapArgs& a) {
     // report and PNG are its bytes (so both paths write the same files,
     // timing aside).
     if (a.settings.split_components) throw CommandFailed("--split-components is in-process only");
-    if (!a.png.empty() && a.png_axis != "auto") throw CommandFailed("--png-axis is in-process only");
+    if (!a.png.empty() && a.png_axis != "auto")
+      throw CommandFailed("--png-axis is in-process only");
     v1::ErrorMapRequest req;
     wire::CloudToProto(cloud_in_world, req.mutable_cloud());
     wire::TransformToProto(world_from_part, req.mutable_world_from_part());
@@ -71,7 +72,8 @@ void RunErrorMap(const ErrorMapArgs& a) {
     req.set_return_png(!a.png.empty());
     const v1::ErrorMapResponse resp = Take(Connect(a.remote)->ErrorMap(req, mesh));
     r.deviation_mm = wire::UnpackFloats(resp.deviations());
-    if (r.deviation_mm.size() != cloud_in_world.size()) throw CommandFailed("server sent a wrong deviation count");
+    if (r.deviation_mm.size() != cloud_in_world.size())
+      throw CommandFailed("server sent a wrong deviation count");
     j = nlohmann::json::parse(resp.report_json(), nullptr, false);
     if (j.is_discarded()) throw CommandFailed("server sent a malformed report");
     r.tolerance_mm = Number(j["tolerance"], "band_mm");
@@ -80,14 +82,16 @@ void RunErrorMap(const ErrorMapArgs& a) {
   } else {
     const std::unique_ptr<MeshIndex> index = Take(MeshIndex::Build(std::move(mesh)));
     spdlog::info("mesh index built in {:.3f} s ({} boundary edges, {} degenerate triangles)",
-                 index->info().build_seconds, topo.boundary_edges, index->info().degenerate_triangles);
+                 index->info().build_seconds, topo.boundary_edges,
+                 index->info().degenerate_triangles);
     r = Take(ComputeErrorMap(*index, cloud_in_world, world_from_part, a.settings));
     spdlog::info("distances for {} points in {:.3f} s", r.stats.count, r.query_seconds);
     j = ErrorMapReportJson(r, a.settings);
     if (!a.png.empty()) {
       ErrorMapPngOptions png;
       png.view_axis = a.png_axis == "x" ? 0 : a.png_axis == "y" ? 1 : a.png_axis == "z" ? 2 : -1;
-      png_bytes = Take(EncodePng(Take(RenderErrorMap(cloud_in_part, r, ComputeBounds(index->mesh()), png))));
+      png_bytes = Take(
+          EncodePng(Take(RenderErrorMap(cloud_in_part, r, ComputeBounds(index->mesh()), png))));
     }
   }
   // Files carry part-frame coordinates by default, so they overlay the CAD.
@@ -103,16 +107,19 @@ void RunErrorMap(const ErrorMapArgs& a) {
   }
   const nlohmann::json& st = j["statistics"];
   const nlohmann::json& pts = j["points"];
-  std::printf("points: %zu (valid %zu, matched %zu within %g mm)\n", pts.value("count", std::size_t{0}),
-              pts.value("valid", std::size_t{0}), pts.value("matched", std::size_t{0}),
-              a.settings.max_distance_mm);
-  std::printf("deviation mm: min %.4f  max %.4f  mean %.4f  std %.4f  rms %.4f\n", Number(st, "min_mm"),
-              Number(st, "max_mm"), Number(st, "mean_mm"), Number(st, "stddev_mm"), Number(st, "rms_mm"));
-  std::printf("percentiles mm: p1 %.4f  p5 %.4f  p50 %.4f  p95 %.4f  p99 %.4f\n", Number(st, "p1_mm"),
-              Number(st, "p5_mm"), Number(st, "p50_mm"), Number(st, "p95_mm"), Number(st, "p99_mm"));
+  std::printf("points: %zu (valid %zu, matched %zu within %g mm)\n",
+              pts.value("count", std::size_t{0}), pts.value("valid", std::size_t{0}),
+              pts.value("matched", std::size_t{0}), a.settings.max_distance_mm);
+  std::printf("deviation mm: min %.4f  max %.4f  mean %.4f  std %.4f  rms %.4f\n",
+              Number(st, "min_mm"), Number(st, "max_mm"), Number(st, "mean_mm"),
+              Number(st, "stddev_mm"), Number(st, "rms_mm"));
+  std::printf("percentiles mm: p1 %.4f  p5 %.4f  p50 %.4f  p95 %.4f  p99 %.4f\n",
+              Number(st, "p1_mm"), Number(st, "p5_mm"), Number(st, "p50_mm"), Number(st, "p95_mm"),
+              Number(st, "p99_mm"));
   std::printf("verdict: %s\n", j["tolerance"].value("reason", std::string("?")).c_str());
   std::printf("wrote %s%s%s%s%s%s%s\n", a.out.c_str(), a.csv.empty() ? "" : ", ", a.csv.c_str(),
-              a.report.empty() ? "" : ", ", a.report.c_str(), a.png.empty() ? "" : ", ", a.png.c_str());
+              a.report.empty() ? "" : ", ", a.report.c_str(), a.png.empty() ? "" : ", ",
+              a.png.c_str());
 }
 
 }  // namespace
@@ -120,30 +127,37 @@ void RunErrorMap(const ErrorMapArgs& a) {
 void AddErrorMapCommand(CLI::App& app) {
   auto a = std::make_shared<ErrorMapArgs>();
   auto* cmd = app.add_subcommand(
-      "errormap", "Signed deviation of a cloud from the CAD mesh (+ above the surface, - below): "
-                  "coloured PLY, CSV, JSON report, PNG");
+      "errormap",
+      "Signed deviation of a cloud from the CAD mesh (+ above the surface, - below): "
+      "coloured PLY, CSV, JSON report, PNG");
   cmd->add_option("--cloud", a->cloud, "measured cloud, world frame (.pcd/.ply)")->required();
   cmd->add_option("--mesh", a->mesh, "CAD mesh, part frame (.stl/.obj/.ply/.off)")->required();
   cmd->add_option("--world-from-part", a->world_from_part, "transform JSON (default identity)");
-  cmd->add_option("--out", a->out, "coloured binary PLY with a float 'deviation' property")->required();
+  cmd->add_option("--out", a->out, "coloured binary PLY with a float 'deviation' property")
+      ->required();
   cmd->add_option("--csv", a->csv, "CSV x,y,z,deviation, one row per input point");
   cmd->add_option("--report", a->report, "JSON report");
   cmd->add_option("--png", a->png, "PNG: map, colour bar, histogram");
   cmd->add_option("--tolerance", a->settings.tolerance_mm, "tolerance band +-MM")
-      ->check(CLI::PositiveNumber)->default_val(0.1);
+      ->check(CLI::PositiveNumber)
+      ->default_val(0.1);
   cmd->add_option("--max-distance", a->settings.max_distance_mm,
                   "points farther from the CAD are unmatched (NaN), mm")
-      ->check(CLI::PositiveNumber)->default_val(5.0);
+      ->check(CLI::PositiveNumber)
+      ->default_val(5.0);
   cmd->add_option("--allowed-outside", a->settings.allowed_fraction_outside,
                   "fraction of matched points allowed outside the band for a pass")
-      ->check(CLI::Range(0.0, 1.0))->default_val(0.0);
+      ->check(CLI::Range(0.0, 1.0))
+      ->default_val(0.0);
   cmd->add_option("--threads", a->settings.threads, "0 = all cores")->check(CLI::Range(0, 1024));
   cmd->add_flag("--split-components", a->settings.split_components,
                 "also X/Y/Z and normal components (CSV columns, report)");
   cmd->add_option("--frame", a->frame, "coordinates written to PLY/CSV")
-      ->check(CLI::IsMember({"part", "world"}))->default_val("part");
+      ->check(CLI::IsMember({"part", "world"}))
+      ->default_val("part");
   cmd->add_option("--png-axis", a->png_axis, "view axis for merged clouds (auto = CAD's thinnest)")
-      ->check(CLI::IsMember({"auto", "x", "y", "z"}))->default_val("auto");
+      ->check(CLI::IsMember({"auto", "x", "y", "z"}))
+      ->default_val("auto");
   AddRemoteOptions(cmd, a->remote);
   cmd->callback([a] { RunErrorMap(*a); });
 }

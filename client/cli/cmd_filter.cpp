@@ -9,11 +9,11 @@
 
 #include "client/cli/commands.h"
 #include "client/cli/remote_args.h"
-#include "proto/convert.h"
 #include "core/atomic_file.h"
 #include "core/io_point_cloud.h"
 #include "core/link_clustering.h"
 #include "core/png_image.h"
+#include "proto/convert.h"
 
 namespace surfinspect::cli {
 namespace {
@@ -71,11 +71,13 @@ void Filter(const FilterArgs& a) {
     wire::FilterStatsToProto(r, resp.mutable_stats());
     resp.mutable_kept_mask()->assign(r.kept_mask.begin(), r.kept_mask.end());
   }
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const v1::FilterStats& stats = resp.stats();
   Check(WritePointCloud(a.out, Take(wire::CloudFromProto(resp.cloud(), "cloud", wire::Limits{}))));
   spdlog::info("{}: {} valid points, kept {}, removed {} in {} clusters ({:.2f} ms)", a.in,
-               stats.valid_points(), stats.kept(), stats.removed(), stats.clusters(), seconds * 1e3);
+               stats.valid_points(), stats.kept(), stats.removed(), stats.clusters(),
+               seconds * 1e3);
   // What the picture needs: which pixels had data and which were kept.
   LinkClusteringResult result;
   result.kept = stats.kept();
@@ -85,25 +87,24 @@ void Filter(const FilterArgs& a) {
   for (std::size_t i = 0; i < cloud.size(); ++i)
     result.labels[i] = PointCloud::IsValid(cloud.points[i]) ? 0 : LinkClusteringResult::kInvalid;
   if (!a.report.empty()) {
-    nlohmann::json j = {
-        {"input", a.in},
-        {"output", a.out},
-        {"organized", cloud.organized()},
-        {"width", cloud.width},
-        {"height", cloud.height},
-        {"input_points", stats.input_points()},
-        {"valid_points", stats.valid_points()},
-        {"kept", stats.kept()},
-        {"removed", stats.removed()},
-        {"clusters", stats.clusters()},
-        {"removed_clusters", stats.removed_clusters()},
-        {"largest_cluster", stats.largest_cluster()},
-        {"seconds", seconds},
-        {"parameters",
-         {{"link_distance_mm", a.settings.link_distance_mm},
-          {"min_cluster_points", a.settings.min_cluster_points},
-          {"connectivity", a.settings.connectivity},
-          {"min_fraction_of_largest", a.settings.min_fraction_of_largest}}}};
+    nlohmann::json j = {{"input", a.in},
+                        {"output", a.out},
+                        {"organized", cloud.organized()},
+                        {"width", cloud.width},
+                        {"height", cloud.height},
+                        {"input_points", stats.input_points()},
+                        {"valid_points", stats.valid_points()},
+                        {"kept", stats.kept()},
+                        {"removed", stats.removed()},
+                        {"clusters", stats.clusters()},
+                        {"removed_clusters", stats.removed_clusters()},
+                        {"largest_cluster", stats.largest_cluster()},
+                        {"seconds", seconds},
+                        {"parameters",
+                         {{"link_distance_mm", a.settings.link_distance_mm},
+                          {"min_cluster_points", a.settings.min_cluster_points},
+                          {"connectivity", a.settings.connectivity},
+                          {"min_fraction_of_largest", a.settings.min_fraction_of_largest}}}};
     Check(WriteStringAtomically(a.report, j.dump(2) + "\n"));
   }
   if (!a.png.empty()) Check(WritePng(a.png, RenderFilterPng(cloud, result)));
@@ -112,9 +113,10 @@ void Filter(const FilterArgs& a) {
 }  // namespace
 
 void AddFilterCommand(CLI::App& app) {
-  auto* cmd = app.add_subcommand(
-      "filter", "Remove outliers (pulses, stripes) by link clustering; kept points are "
-                "never moved, removed points become NaN");
+  auto* cmd =
+      app.add_subcommand("filter",
+                         "Remove outliers (pulses, stripes) by link clustering; kept points are "
+                         "never moved, removed points become NaN");
   auto a = std::make_shared<FilterArgs>();
   cmd->add_option("--in", a->in, "input cloud (.pcd/.ply)")->required();
   cmd->add_option("--out", a->out, "filtered cloud (.pcd keeps the grid)")->required();

@@ -48,8 +48,7 @@ void Info(const std::string& path) {
   const TriangleMesh mesh = Take(ReadMesh(path));
   const MeshTopology topo = AnalyzeTopology(mesh);
   std::printf("file: %s\ntype: mesh\nvertices: %zu\ntriangles: %zu\ndegenerate: %zu\n",
-              path.c_str(), mesh.vertices.size(), mesh.num_triangles(),
-              mesh.CountDegenerate());
+              path.c_str(), mesh.vertices.size(), mesh.num_triangles(), mesh.CountDegenerate());
   std::printf("closed: %s (boundary edges %zu, non-manifold edges %zu)\n",
               topo.closed() ? "yes" : "no", topo.boundary_edges, topo.nonmanifold_edges);
   PrintBounds(ComputeBounds(mesh));
@@ -58,8 +57,9 @@ void Info(const std::string& path) {
 }  // namespace
 
 void AddInfoCommand(CLI::App& app) {
-  auto* cmd = app.add_subcommand("info", "Print what a cloud (.pcd/.ply) or mesh "
-                                         "(.stl/.obj/.ply/.off) file holds");
+  auto* cmd = app.add_subcommand("info",
+                                 "Print what a cloud (.pcd/.ply) or mesh "
+                                 "(.stl/.obj/.ply/.off) file holds");
   auto path = std::make_shared<std::string>();
   cmd->add_option("file", *path, "cloud or mesh file")->required();
   cmd->callback([path] { Info(*path); });

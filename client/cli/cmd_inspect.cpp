@@ -33,7 +33,8 @@ void Inspect(const InspectArgs& a) {
     const std::string path = a.scans + "/" + vp.name + ".pcd";
     if (!std::filesystem::exists(path)) continue;
     if (!vp.world_from_sensor)
-      throw CommandFailed(a.cell + ": viewpoint " + vp.name + " is not calibrated (run cell-agent calibrate)");
+      throw CommandFailed(a.cell + ": viewpoint " + vp.name +
+                          " is not calibrated (run cell-agent calibrate)");
     views.push_back({vp.name, Take(ReadPointCloud(path)), *vp.world_from_sensor});
   }
   if (views.empty()) throw CommandFailed(a.scans + ": no <viewpoint>.pcd scans for this cell");
@@ -48,12 +49,13 @@ void Inspect(const InspectArgs& a) {
     outputs = Take(client::OutputsFromRemote(result));
   } else {
     auto index = Take(MeshIndex::Build(part));
-    const InspectionResult r = Take(InspectPart(*index, cell.world_from_part, std::move(views), settings));
+    const InspectionResult r =
+        Take(InspectPart(*index, cell.world_from_part, std::move(views), settings));
     outputs = Take(client::OutputsFromLocal(part_id, r, settings, cell.world_from_part, part));
   }
   Check(client::WritePartOutputs(a.out, outputs));
-  std::printf("%s: %s  (min %.3f mm, max %.3f mm)  -> %s\n", part_id.c_str(), outputs.verdict.c_str(),
-              outputs.min_mm, outputs.max_mm, a.out.c_str());
+  std::printf("%s: %s  (min %.3f mm, max %.3f mm)  -> %s\n", part_id.c_str(),
+              outputs.verdict.c_str(), outputs.min_mm, outputs.max_mm, a.out.c_str());
 }
 
 }  // namespace
@@ -61,11 +63,15 @@ void Inspect(const InspectArgs& a) {
 void AddInspectCommand(CLI::App& app) {
   auto a = std::make_shared<InspectArgs>();
   auto* cmd = app.add_subcommand("inspect", "Inspect a whole part: filter, register, error map");
-  cmd->add_option("--cell", a->cell, "cell.json (calibrated viewpoints, part mesh and pose)")->required();
+  cmd->add_option("--cell", a->cell, "cell.json (calibrated viewpoints, part mesh and pose)")
+      ->required();
   cmd->add_option("--scans", a->scans, "folder with <viewpoint>.pcd scans of one part")->required();
-  cmd->add_option("--out", a->out, "results folder (report.json, errormap.ply/.png, deviations.csv)")->required();
+  cmd->add_option("--out", a->out,
+                  "results folder (report.json, errormap.ply/.png, deviations.csv)")
+      ->required();
   cmd->add_option("--part-id", a->part_id, "default: the scans folder's name");
-  cmd->add_option("--tolerance", a->tolerance, "override the cell's tolerance, mm")->check(CLI::PositiveNumber);
+  cmd->add_option("--tolerance", a->tolerance, "override the cell's tolerance, mm")
+      ->check(CLI::PositiveNumber);
   AddRemoteOptions(cmd, a->remote);
   cmd->callback([a] { Inspect(*a); });
 }

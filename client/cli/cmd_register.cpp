@@ -59,7 +59,8 @@ void AddRegisterCommand(CLI::App& app) {
   auto a = std::make_shared<RegisterArgs>();
   auto* cmd = app.add_subcommand("register", "Transform scans into the world frame and merge them");
   cmd->add_option("--scan", a->scans, "scan (sensor frame); repeat per viewpoint")->required();
-  cmd->add_option("--world-from-sensor", a->poses, "calibrated pose JSON; one per --scan")->required();
+  cmd->add_option("--world-from-sensor", a->poses, "calibrated pose JSON; one per --scan")
+      ->required();
   cmd->add_option("--out", a->out, "merged cloud (.ply or .pcd)")->required();
   cmd->add_flag("--filter", a->filter, "link-clustering filter each scan first");
   AddRemoteOptions(cmd, a->remote);

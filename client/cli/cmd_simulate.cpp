@@ -64,7 +64,8 @@ void Simulate(const SimulateArgs& a) {
     const nlohmann::json truth = {
         {"width", scan.cloud_in_sensor.width},
         {"height", scan.cloud_in_sensor.height},
-        {"label_codes", {{"0", "no_data"}, {"1", "good"}, {"2", "pulse"}, {"3", "stripe"}, {"4", "defect"}}},
+        {"label_codes",
+         {{"0", "no_data"}, {"1", "good"}, {"2", "pulse"}, {"3", "stripe"}, {"4", "defect"}}},
         {"labels", label_string},
         {"valid_points", scan.hits},
         {"pulses", scan.pulses},
@@ -96,14 +97,17 @@ void WriteCell(const std::string& out, int parts, uint64_t seed) {
 
 void AddSimulateCommands(CLI::App& app) {
   auto a = std::make_shared<SimulateArgs>();
-  auto* sim = app.add_subcommand("simulate", "Scan a mesh with the virtual area sensor "
-                                             "(1024x768, 35 deg; cloud in the sensor frame)");
+  auto* sim = app.add_subcommand("simulate",
+                                 "Scan a mesh with the virtual area sensor "
+                                 "(1024x768, 35 deg; cloud in the sensor frame)");
   sim->add_option("--mesh", a->mesh, "part mesh (part frame, mm)")->required();
   sim->add_option("--world-from-part", a->world_from_part, "transform JSON (default identity)");
   sim->add_option("--world-from-sensor", a->world_from_sensor, "transform JSON")->required();
   sim->add_option("--out", a->out, "organized cloud to write (.pcd)")->required();
-  sim->add_option("--noise", a->noise, "Gaussian noise along the ray, sigma in mm")->check(CLI::NonNegativeNumber);
-  sim->add_option("--pulses", a->pulses, "fraction of valid pixels made pulse outliers")->check(CLI::Range(0.0, 1.0));
+  sim->add_option("--noise", a->noise, "Gaussian noise along the ray, sigma in mm")
+      ->check(CLI::NonNegativeNumber);
+  sim->add_option("--pulses", a->pulses, "fraction of valid pixels made pulse outliers")
+      ->check(CLI::Range(0.0, 1.0));
   sim->add_flag("--stripes", a->stripes, "mixed-pixel stripes at depth discontinuities");
   sim->add_option("--dent", a->dents, "x,y,z,radius,depth (mm, part frame; depth<0 = bump)");
   sim->add_option("--seed", a->seed, "random seed");
@@ -113,8 +117,9 @@ void AddSimulateCommands(CLI::App& app) {
   auto out = std::make_shared<std::string>();
   auto parts = std::make_shared<int>(3);
   auto seed = std::make_shared<uint64_t>(1);
-  auto* demo = app.add_subcommand("demo-cell", "Write the built-in demo cell: pillar part, gauge, "
-                                               "viewpoints and simulated scans");
+  auto* demo = app.add_subcommand("demo-cell",
+                                  "Write the built-in demo cell: pillar part, gauge, "
+                                  "viewpoints and simulated scans");
   demo->add_option("--out", *out, "directory")->required();
   demo->add_option("--parts", *parts, "production parts to scan")->check(CLI::Range(0, 1000));
   demo->add_option("--seed", *seed, "random seed");

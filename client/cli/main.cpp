@@ -8,8 +8,9 @@
 
 int main(int argc, char** argv) {
   surfinspect::ReuseFreedLargeBuffers();  // clouds are ~10 MB buffers, over and over
-  CLI::App app{"surfinspect: point-cloud filtering, calibration, registration and "
-               "error maps against CAD (units: mm)"};
+  CLI::App app{
+      "surfinspect: point-cloud filtering, calibration, registration and "
+      "error maps against CAD (units: mm)"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "surfinspect 0.1.0");
   // Logs and errors go to stderr so stdout stays clean for piping results.

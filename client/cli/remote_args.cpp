@@ -14,10 +14,12 @@ void AddRemoteOptions(CLI::App* cmd, RemoteArgs& a) {
   cmd->add_option("--tls-ca", a.tls_ca, "PEM CA that signed the server certificate (enables TLS)");
   cmd->add_option("--tls-cert", a.tls_cert, "client certificate (mTLS)");
   cmd->add_option("--tls-key", a.tls_key, "client key (mTLS)");
-  cmd->add_option("--tls-server-name", a.tls_server_name, "expected name in the server certificate");
+  cmd->add_option("--tls-server-name", a.tls_server_name,
+                  "expected name in the server certificate");
   cmd->add_option("--token-file", a.token_file, "file with the bearer token")
       ->envname("SURFINSPECT_TOKEN_FILE");
-  cmd->add_option("--timeout", a.timeout_s, "per-call deadline, seconds")->check(CLI::PositiveNumber);
+  cmd->add_option("--timeout", a.timeout_s, "per-call deadline, seconds")
+      ->check(CLI::PositiveNumber);
 }
 
 std::unique_ptr<client::RemoteClient> Connect(const RemoteArgs& a) {
@@ -29,7 +31,8 @@ std::unique_ptr<client::RemoteClient> Connect(const RemoteArgs& a) {
   o.tls_server_name = a.tls_server_name;
   o.timeout_s = a.timeout_s;
   if (!a.token_file.empty())
-    o.auth_token = std::string(absl::StripAsciiWhitespace(Take(ReadFileToString(a.token_file, 4096))));
+    o.auth_token =
+        std::string(absl::StripAsciiWhitespace(Take(ReadFileToString(a.token_file, 4096))));
   return Take(client::RemoteClient::Connect(o));
 }
 

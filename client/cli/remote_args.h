@@ -10,7 +10,7 @@
 namespace surfinspect::cli {
 
 struct RemoteArgs {
-  std::string server;       // empty = run in-process
+  std::string server;  // empty = run in-process
   std::string tls_ca, tls_cert, tls_key, tls_server_name, token_file;
   double timeout_s = 600;
   bool remote() const { return !server.empty(); }

@@ -8,8 +8,8 @@
 #include "absl/strings/str_cat.h"
 #include "core/atomic_file.h"
 #include "core/mesh_hash.h"
-#include "proto/convert.h"
 #include "grpc/health/v1/health.grpc.pb.h"
+#include "proto/convert.h"
 
 namespace surfinspect::client {
 
@@ -31,7 +31,8 @@ absl::StatusOr<std::unique_ptr<RemoteClient>> RemoteClient::Connect(const Remote
   if (o.target.empty()) return absl::InvalidArgumentError("--server: empty target");
   std::shared_ptr<grpc::ChannelCredentials> creds;
   if (o.tls_ca_file.empty()) {
-    if (!o.tls_cert_file.empty()) return absl::InvalidArgumentError("client certificate needs --tls-ca");
+    if (!o.tls_cert_file.empty())
+      return absl::InvalidArgumentError("client certificate needs --tls-ca");
     creds = grpc::InsecureChannelCredentials();
   } else {
     grpc::SslCredentialsOptions ssl;
@@ -64,7 +65,8 @@ RemoteClient::RemoteClient(const RemoteOptions& o, std::shared_ptr<grpc::Channel
 void RemoteClient::Prepare(grpc::ClientContext* ctx) const {
   ctx->set_deadline(std::chrono::system_clock::now() +
                     std::chrono::milliseconds(static_cast<int64_t>(options_.timeout_s * 1000)));
-  if (!options_.auth_token.empty()) ctx->AddMetadata("authorization", "Bearer " + options_.auth_token);
+  if (!options_.auth_token.empty())
+    ctx->AddMetadata("authorization", "Bearer " + options_.auth_token);
   ctx->set_wait_for_ready(true);  // ride out a replica restarting
 }
 
@@ -215,7 +217,8 @@ absl::StatusOr<std::string> RemoteClient::Health(const std::string& service) {
   auto health = grpc::health::v1::Health::NewStub(channel_);
   grpc::ClientContext ctx;
   ctx.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(5));
-  if (!options_.auth_token.empty()) ctx.AddMetadata("authorization", "Bearer " + options_.auth_token);
+  if (!options_.auth_token.empty())
+    ctx.AddMetadata("authorization", "Bearer " + options_.auth_token);
   grpc::health::v1::HealthCheckRequest req;
   req.set_service(service);
   grpc::health::v1::HealthCheckResponse resp;

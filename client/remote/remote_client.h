@@ -26,12 +26,12 @@ struct RemoteOptions {
   // Any gRPC target: "host:port", "dns:///svc:50051",
   // "ipv4:127.0.0.1:50051,127.0.0.1:50052" (then round_robin spreads calls).
   std::string target;
-  std::string tls_ca_file;        // set = TLS, verifying the server with this CA
-  std::string tls_cert_file;      // client certificate (mTLS) ...
-  std::string tls_key_file;       // ... and its key
-  std::string tls_server_name;    // override the name checked in the server cert
-  std::string auth_token;         // sent as "authorization: Bearer <token>"
-  double timeout_s = 600;         // per call
+  std::string tls_ca_file;            // set = TLS, verifying the server with this CA
+  std::string tls_cert_file;          // client certificate (mTLS) ...
+  std::string tls_key_file;           // ... and its key
+  std::string tls_server_name;        // override the name checked in the server cert
+  std::string auth_token;             // sent as "authorization: Bearer <token>"
+  double timeout_s = 600;             // per call
   std::size_t chunk_bytes = 1 << 20;  // Inspect chunk size
 };
 

@@ -9,8 +9,8 @@ namespace surfinspect {
 namespace {
 
 // Independent oracle: Kabsch / Umeyama via SVD of the weighted covariance.
-Eigen::Isometry3d Kabsch(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b,
-                         const std::vector<double>& w) {
+Eigen::Isometry3d Kabsch(const std::vector<Eigen::Vector3d>& a,
+                         const std::vector<Eigen::Vector3d>& b, const std::vector<double>& w) {
   double ws = 0;
   Eigen::Vector3d ca = Eigen::Vector3d::Zero(), cb = Eigen::Vector3d::Zero();
   for (std::size_t i = 0; i < a.size(); ++i) ws += w[i], ca += w[i] * a[i], cb += w[i] * b[i];
@@ -34,7 +34,8 @@ TEST(HornAbsoluteOrientation, MatchesKabschOnRandomNoisySets) {
   for (int trial = 0; trial < 200; ++trial) {
     const int n = 3 + trial % 40;
     Eigen::Isometry3d truth = Eigen::Isometry3d::Identity();
-    truth.linear() = Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix();
+    truth.linear() =
+        Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix();
     truth.translation() = 100 * Eigen::Vector3d(g(rng), g(rng), g(rng));
     std::vector<Eigen::Vector3d> a, b;
     std::vector<double> w;
@@ -52,7 +53,8 @@ TEST(HornAbsoluteOrientation, MatchesKabschOnRandomNoisySets) {
 
 TEST(HornAbsoluteOrientation, RecoversExactTransform) {
   Eigen::Isometry3d truth = Eigen::Isometry3d::Identity();
-  truth.linear() = Eigen::AngleAxisd(2.5, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
+  truth.linear() =
+      Eigen::AngleAxisd(2.5, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
   truth.translation() = Eigen::Vector3d(400, -20, 7);
   std::vector<Eigen::Vector3d> a = {{0, 0, 0}, {10, 0, 0}, {0, 20, 0}, {3, 4, 30}}, b;
   for (const auto& p : a) b.push_back(truth * p);
@@ -67,9 +69,11 @@ TEST(HornAbsoluteOrientation, RejectsDegenerateInput) {
   EXPECT_FALSE(HornAbsoluteOrientation({{0, 0, 0}, {1, 0, 0}}, {{0, 0, 0}, {1, 0, 0}}).ok());
   EXPECT_FALSE(HornAbsoluteOrientation({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 0, 0}}).ok());
   EXPECT_FALSE(HornAbsoluteOrientation({{0, 0, NAN}, {1, 0, 0}, {0, 1, 0}},
-                                       {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}).ok());
+                                       {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}})
+                   .ok());
   EXPECT_FALSE(HornAbsoluteOrientation({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}},
-                                       {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {0, 0, 0}).ok());
+                                       {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {0, 0, 0})
+                   .ok());
 }
 
 }  // namespace

@@ -17,8 +17,9 @@ namespace {
 Eigen::Isometry3d Perturb(std::mt19937_64& rng, double mm, double deg) {
   std::normal_distribution<double> g;
   Eigen::Isometry3d d = Eigen::Isometry3d::Identity();
-  d.linear() = Eigen::AngleAxisd(deg * M_PI / 180, Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized())
-                   .toRotationMatrix();
+  d.linear() =
+      Eigen::AngleAxisd(deg * M_PI / 180, Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized())
+          .toRotationMatrix();
   d.translation() = mm * Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized();
   return d;
 }
@@ -58,13 +59,15 @@ class CalibrationGroundTruth : public ::testing::Test {
       const Eigen::Isometry3d initial = vp.world_from_sensor * Perturb(rng, 5.0, 5.0);
       CalibrationSettings s;
       s.icp.step = step;
-      auto cal = CalibrateViewpoint(*gauge_, vp.world_from_gauge, scan->cloud_in_sensor, initial, s);
+      auto cal =
+          CalibrateViewpoint(*gauge_, vp.world_from_gauge, scan->cloud_in_sensor, initial, s);
       EXPECT_TRUE(cal.ok()) << cal.status();
       if (!cal.ok()) continue;
       const PoseDifference e = ComparePoses(vp.world_from_sensor, cal->world_from_sensor);
       // Translation error at the sensor origin, in µm.
       const double t_um =
-          1000.0 * (vp.world_from_sensor.translation() - cal->world_from_sensor.translation()).norm();
+          1000.0 *
+          (vp.world_from_sensor.translation() - cal->world_from_sensor.translation()).norm();
       cases.push_back({t_um, e.rotation_deg, cal->sigma_translation_um, cal->sigma_rotation_deg,
                        cal->icp.iterations, cal->icp.converged, cal->degenerate});
     }
@@ -139,7 +142,8 @@ TEST_F(CalibrationGroundTruth, PlanarGaugeScanIsFlaggedDegenerate) {
 
 TEST_F(CalibrationGroundTruth, CancelledAndBadInput) {
   const DemoViewpoint& vp = cell_->viewpoints[0];
-  auto scan = SimulateScan(cell_->gauge, vp.world_from_gauge, vp.world_from_sensor, cell_->intrinsics, {});
+  auto scan =
+      SimulateScan(cell_->gauge, vp.world_from_gauge, vp.world_from_sensor, cell_->intrinsics, {});
   ASSERT_TRUE(scan.ok());
   std::atomic<bool> cancel{true};
   auto cancelled = CalibrateViewpoint(*gauge_, vp.world_from_gauge, scan->cloud_in_sensor,
@@ -148,13 +152,16 @@ TEST_F(CalibrationGroundTruth, CancelledAndBadInput) {
   CalibrationSettings bad;
   bad.icp.max_correspondence_mm = -1;
   EXPECT_EQ(CalibrateViewpoint(*gauge_, vp.world_from_gauge, scan->cloud_in_sensor,
-                               vp.world_from_sensor, bad).status().code(),
+                               vp.world_from_sensor, bad)
+                .status()
+                .code(),
             absl::StatusCode::kInvalidArgument);
   // 100 mm off: nothing within the gate, a clear precondition error.
   Eigen::Isometry3d far = vp.world_from_sensor;
   far.translation() += Eigen::Vector3d(0, 0, 100);
   EXPECT_EQ(CalibrateViewpoint(*gauge_, vp.world_from_gauge, scan->cloud_in_sensor, far, {})
-                .status().code(),
+                .status()
+                .code(),
             absl::StatusCode::kFailedPrecondition);
 }
 

@@ -48,10 +48,10 @@ TEST(DemoCell, FiveViewpointsSeeTheRidgeAndTheirGauges) {
     const PoseDifference off = ComparePoses(vp.world_from_sensor, vp.nominal_world_from_sensor);
     EXPECT_NEAR(off.translation_mm, 3.0, 1e-9);
     EXPECT_NEAR(off.rotation_deg, 2.0, 1e-9);
-    auto part_scan = SimulateScan(cell.part, cell.world_from_part, vp.world_from_sensor,
-                                  cell.intrinsics, {});
-    auto gauge_scan = SimulateScan(cell.gauge, vp.world_from_gauge, vp.world_from_sensor,
-                                   cell.intrinsics, {});
+    auto part_scan =
+        SimulateScan(cell.part, cell.world_from_part, vp.world_from_sensor, cell.intrinsics, {});
+    auto gauge_scan =
+        SimulateScan(cell.gauge, vp.world_from_gauge, vp.world_from_sensor, cell.intrinsics, {});
     ASSERT_TRUE(part_scan.ok() && gauge_scan.ok());
     EXPECT_GT(part_scan->hits, 200000u) << vp.name;
     EXPECT_GT(gauge_scan->hits, 150000u) << vp.name;

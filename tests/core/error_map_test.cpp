@@ -42,7 +42,8 @@ PointCloud Above(const std::vector<double>& z, uint64_t seed = 1) {
   std::uniform_real_distribution<float> u(10, 90);
   std::vector<Vector3f> pts;
   for (double h : z)
-    pts.push_back(std::isnan(h) ? Vector3f::Constant(NAN) : Vector3f(u(rng), u(rng), static_cast<float>(h)));
+    pts.push_back(std::isnan(h) ? Vector3f::Constant(NAN)
+                                : Vector3f(u(rng), u(rng), static_cast<float>(h)));
   return PointCloud::Unorganized(pts);
 }
 
@@ -121,9 +122,12 @@ TEST(ErrorMap, DeviationsStatisticsHistogramAndVerdictOnAPlane) {
   std::size_t out_low = 0, out_high = 0;
   for (double d : matched) {
     const double k = std::floor((d - h.min_mm) / h.bin_width_mm());
-    if (k < 0) ++out_low;
-    else if (k >= 41) ++out_high;
-    else ++want[static_cast<std::size_t>(k)];
+    if (k < 0)
+      ++out_low;
+    else if (k >= 41)
+      ++out_high;
+    else
+      ++want[static_cast<std::size_t>(k)];
   }
   EXPECT_EQ(h.counts, want);
   EXPECT_EQ(h.below_range, out_low);
@@ -225,7 +229,8 @@ TEST(ErrorMap, ThreadCountDoesNotChangeAnything) {
   s.threads = 2;
   auto two = ComputeErrorMap(*index, cloud, Eigen::Isometry3d::Identity(), s);
   ASSERT_TRUE(one.ok() && two.ok());
-  ASSERT_EQ(0, std::memcmp(one->deviation_mm.data(), two->deviation_mm.data(), pts.size() * sizeof(float)));
+  ASSERT_EQ(0, std::memcmp(one->deviation_mm.data(), two->deviation_mm.data(),
+                           pts.size() * sizeof(float)));
   EXPECT_EQ(one->triangle_id, two->triangle_id);
   EXPECT_EQ(one->stats.rms_mm, two->stats.rms_mm);
   EXPECT_EQ(one->stats.p99_mm, two->stats.p99_mm);
@@ -264,8 +269,9 @@ TEST(ErrorMap, RejectsBadSettingsAndHonoursCancel) {
   bad_pose(0, 3) = INFINITY;
   EXPECT_EQ(ComputeErrorMap(*index, cloud, bad_pose, {}).status().code(), kBad);
   std::atomic<bool> cancel{true};
-  EXPECT_EQ(ComputeErrorMap(*index, cloud, Eigen::Isometry3d::Identity(), {}, &cancel).status().code(),
-            absl::StatusCode::kCancelled);
+  EXPECT_EQ(
+      ComputeErrorMap(*index, cloud, Eigen::Isometry3d::Identity(), {}, &cancel).status().code(),
+      absl::StatusCode::kCancelled);
 }
 
 TEST(ErrorMap, AutoColorRangeRoundsUpToNiceNumbers) {
@@ -295,8 +301,10 @@ TEST(ErrorMapOutput, ColourScaleIsDivergingWithToleranceBands) {
     EXPECT_GT(c.b, 180);
     EXPECT_EQ(c.r, 0);
   }
-  EXPECT_GT(DeviationColor(0.12, tol, range).g, DeviationColor(0.45, tol, range).g) << "yellow to red";
-  EXPECT_FALSE(DeviationColor(0.6, tol, range) == DeviationColor(0.5, tol, range)) << "beyond the scale";
+  EXPECT_GT(DeviationColor(0.12, tol, range).g, DeviationColor(0.45, tol, range).g)
+      << "yellow to red";
+  EXPECT_FALSE(DeviationColor(0.6, tol, range) == DeviationColor(0.5, tol, range))
+      << "beyond the scale";
 }
 
 struct ScanFixture {
@@ -312,7 +320,10 @@ ScanFixture SmallOrganizedScan() {
   for (uint32_t r = 0; r < 30; ++r)
     for (uint32_t c = 0; c < 40; ++c) {
       if ((r * 40 + c) % 17 == 0) continue;  // NaN holes
-      const float z = c < 10 ? 0.5f : c < 20 ? -0.5f : c < 30 ? 0.01f : 20.f;  // last block unmatched
+      const float z = c < 10   ? 0.5f
+                      : c < 20 ? -0.5f
+                      : c < 30 ? 0.01f
+                               : 20.f;  // last block unmatched
       f.cloud.points[r * 40 + c] = Vector3f(10 + 2 * c, 10 + 2 * r, z);
     }
   ErrorMapSettings s;
@@ -374,7 +385,8 @@ TEST(ErrorMapOutput, CsvHasOneRowPerInputPointInOrder) {
     std::vector<float> v;
     std::stringstream ss(line);
     std::string cell;
-    while (std::getline(ss, cell, ',')) v.push_back(cell == "nan" ? NAN : std::strtof(cell.c_str(), nullptr));
+    while (std::getline(ss, cell, ','))
+      v.push_back(cell == "nan" ? NAN : std::strtof(cell.c_str(), nullptr));
     ASSERT_EQ(v.size(), 8u) << line;
     if (!PointCloud::IsValid(f.cloud.points[i])) {
       EXPECT_EQ(line, "nan,nan,nan,nan,nan,nan,nan,nan");
@@ -400,7 +412,8 @@ TEST(ErrorMapOutput, ReportJsonCarriesTheNumbers) {
   EXPECT_EQ(j["tolerance"]["verdict"], "fail");
   EXPECT_EQ(j["tolerance"]["above"], f.result.verdict.above);
   EXPECT_DOUBLE_EQ(j["statistics"]["p50_mm"].get<double>(), f.result.stats.p50_mm);
-  std::size_t total = j["histogram"]["below_range"].get<std::size_t>() + j["histogram"]["above_range"].get<std::size_t>();
+  std::size_t total = j["histogram"]["below_range"].get<std::size_t>() +
+                      j["histogram"]["above_range"].get<std::size_t>();
   for (const auto& c : j["histogram"]["counts"]) total += c.get<std::size_t>();
   EXPECT_EQ(total, f.result.stats.matched);
 }
@@ -415,13 +428,17 @@ TEST(ErrorMapOutput, PngOfAnOrganizedScanIsTheSensorGridWithPanel) {
   const ErrorMapResult& r = f.result;
   // Pixel (col 5, row 1): +0.5 mm; (15, 1): -0.5; (25, 1): in tolerance;
   // (35, 1): unmatched grey; (0, 0) is a NaN hole (index 0): white.
-  EXPECT_EQ(img->at(55, 15), DeviationColor(r.deviation_mm[40 + 5], r.tolerance_mm, r.color_range_mm));
-  EXPECT_EQ(img->at(155, 15), DeviationColor(r.deviation_mm[40 + 15], r.tolerance_mm, r.color_range_mm));
-  EXPECT_EQ(img->at(255, 15), DeviationColor(r.deviation_mm[40 + 25], r.tolerance_mm, r.color_range_mm));
+  EXPECT_EQ(img->at(55, 15),
+            DeviationColor(r.deviation_mm[40 + 5], r.tolerance_mm, r.color_range_mm));
+  EXPECT_EQ(img->at(155, 15),
+            DeviationColor(r.deviation_mm[40 + 15], r.tolerance_mm, r.color_range_mm));
+  EXPECT_EQ(img->at(255, 15),
+            DeviationColor(r.deviation_mm[40 + 25], r.tolerance_mm, r.color_range_mm));
   EXPECT_EQ(img->at(355, 15), kUnmatchedGrey);
   EXPECT_EQ(img->at(5, 5), (Rgb{255, 255, 255}));
   TempDir dir;
-  ASSERT_TRUE(WriteErrorMapPng(dir.File("map.png"), f.cloud, r, ComputeBounds(f.index->mesh())).ok());
+  ASSERT_TRUE(
+      WriteErrorMapPng(dir.File("map.png"), f.cloud, r, ComputeBounds(f.index->mesh())).ok());
   const std::string bytes = testing::ReadBytes(dir.File("map.png"));
   ASSERT_GT(bytes.size(), 24u);
   EXPECT_EQ(bytes.substr(1, 3), "PNG");
@@ -446,7 +463,8 @@ TEST(ErrorMapOutput, PngOfAMergedCloudLooksAlongTheThinnestAxis) {
     for (uint32_t x = 0; x < map_w; ++x) {
       const Rgb c = img->at(x, y);
       if (c == DeviationColor(0.5, r.tolerance_mm, r.color_range_mm)) red += x < map_w / 4 ? 1 : 0;
-      if (c == DeviationColor(-0.5, r.tolerance_mm, r.color_range_mm)) blue += x >= map_w / 4 && x < map_w / 2 ? 1 : 0;
+      if (c == DeviationColor(-0.5, r.tolerance_mm, r.color_range_mm))
+        blue += x >= map_w / 4 && x < map_w / 2 ? 1 : 0;
     }
   EXPECT_GT(red, 1000u);
   EXPECT_GT(blue, 1000u);
@@ -459,8 +477,11 @@ TEST(ErrorMapDemo, DentCentreDeviationIsThePlantedDepth) {
   auto index = Index(cell.part);
   ASSERT_TRUE(index);
   const Bounds3 b = ComputeBounds(cell.part);
-  struct Planted { double x, y, depth, radius; };
-  for (const Planted& p : {Planted{-60, 5, 0.30, 6}, Planted{40, -12, 0.08, 4}, Planted{95, 0, -0.2, 7}}) {
+  struct Planted {
+    double x, y, depth, radius;
+  };
+  for (const Planted& p :
+       {Planted{-60, 5, 0.30, 6}, Planted{40, -12, 0.08, 4}, Planted{95, 0, -0.2, 7}}) {
     // The dent centre on the CAD ridge: the closest surface point below (x, y, top).
     const ClosestPoint top = index->Closest(Vector3d(p.x, p.y, b.max.z() + 5));
     ASSERT_TRUE(top.matched());
@@ -475,7 +496,8 @@ TEST(ErrorMapDemo, DentCentreDeviationIsThePlantedDepth) {
     const Vector3d up_world = cell.world_from_part.linear() * top.normal;
     const Eigen::Isometry3d world_from_sensor =
         LookAt(centre_world + 400 * up_world + Vector3d(7, 3, 0), centre_world);
-    auto scan = SimulateScan(cell.part, cell.world_from_part, world_from_sensor, cell.intrinsics, opt);
+    auto scan =
+        SimulateScan(cell.part, cell.world_from_part, world_from_sensor, cell.intrinsics, opt);
     ASSERT_TRUE(scan.ok()) << scan.status();
     const PointCloud in_world = TransformCloud(scan->cloud_in_sensor, world_from_sensor);
     ErrorMapSettings s;

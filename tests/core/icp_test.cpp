@@ -27,7 +27,8 @@ class Icp : public ::testing::Test {
   }
   Eigen::Isometry3d Off(double mm, double deg) const {
     Eigen::Isometry3d d = Eigen::Isometry3d::Identity();
-    d.linear() = Eigen::AngleAxisd(deg * M_PI / 180, Eigen::Vector3d(1, 2, -1).normalized()).toRotationMatrix();
+    d.linear() = Eigen::AngleAxisd(deg * M_PI / 180, Eigen::Vector3d(1, 2, -1).normalized())
+                     .toRotationMatrix();
     d.translation() = mm * Eigen::Vector3d(-2, 1, 1).normalized();
     return sensor_pose_ * d;
   }
@@ -112,15 +113,18 @@ TEST_F(Icp, StopReasons) {
 TEST_F(Icp, RejectsBadInput) {
   IcpSettings s;
   s.trim_fraction = 0.95;
-  EXPECT_EQ(RunIcp(*index_, scan_, Off(1, 1), s).status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(RunIcp(*index_, scan_, Off(1, 1), s).status().code(),
+            absl::StatusCode::kInvalidArgument);
   s = {};
   s.min_correspondence_mm = NAN;
-  EXPECT_EQ(RunIcp(*index_, scan_, Off(1, 1), s).status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(RunIcp(*index_, scan_, Off(1, 1), s).status().code(),
+            absl::StatusCode::kInvalidArgument);
   EXPECT_EQ(RunIcp(*index_, PointCloud::Organized(4, 4), Off(1, 1), {}).status().code(),
             absl::StatusCode::kInvalidArgument);
   Eigen::Isometry3d nan_pose = Off(1, 1);
   nan_pose.translation().x() = NAN;
-  EXPECT_EQ(RunIcp(*index_, scan_, nan_pose, {}).status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(RunIcp(*index_, scan_, nan_pose, {}).status().code(),
+            absl::StatusCode::kInvalidArgument);
 }
 
 }  // namespace

@@ -27,7 +27,8 @@ double SignedVolume(const TriangleMesh& m) {
   double v = 0;
   for (const auto& t : m.triangles)
     v += m.vertices[t[0]].cast<double>().dot(
-             m.vertices[t[1]].cast<double>().cross(m.vertices[t[2]].cast<double>())) / 6.0;
+             m.vertices[t[1]].cast<double>().cross(m.vertices[t[2]].cast<double>())) /
+         6.0;
   return v;
 }
 
@@ -54,13 +55,13 @@ TEST_P(MeshRoundTrip, KeepsShapeTopologyAndWinding) {
   EXPECT_NEAR(SignedVolume(*back), 1000.0, 1e-6);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Formats, MeshRoundTrip,
-    ::testing::Values(std::make_pair(MeshFormat::kStlBinary, "cube.stl"),
-                      std::make_pair(MeshFormat::kStlAscii, "cube_ascii.stl"),
-                      std::make_pair(MeshFormat::kObj, "cube.obj"),
-                      std::make_pair(MeshFormat::kPlyBinary, "cube.ply"),
-                      std::make_pair(MeshFormat::kPlyAscii, "cube_ascii.ply")));
+INSTANTIATE_TEST_SUITE_P(Formats, MeshRoundTrip,
+                         ::testing::Values(std::make_pair(MeshFormat::kStlBinary, "cube.stl"),
+                                           std::make_pair(MeshFormat::kStlAscii, "cube_ascii.stl"),
+                                           std::make_pair(MeshFormat::kObj, "cube.obj"),
+                                           std::make_pair(MeshFormat::kPlyBinary, "cube.ply"),
+                                           std::make_pair(MeshFormat::kPlyAscii,
+                                                          "cube_ascii.ply")));
 
 TEST(ReadMesh, Off) {
   TempDir dir;
@@ -100,8 +101,7 @@ TEST_P(MalformedMesh, GivesClearError) {
   WriteBytes(path, GetParam().bytes);
   auto m = ReadMesh(path);
   ASSERT_FALSE(m.ok());
-  EXPECT_NE(m.status().message().find(GetParam().message_part), std::string::npos)
-      << m.status();
+  EXPECT_NE(m.status().message().find(GetParam().message_part), std::string::npos) << m.status();
   EXPECT_NE(m.status().message().find(path), std::string::npos) << "names the file";
 }
 
@@ -121,8 +121,7 @@ INSTANTIATE_TEST_SUITE_P(
                 "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
                 "property float z\nend_header\n0 0 0\n1 1 1\n",
                 "cannot import"},
-        BadMesh{"garbage", "g.stl", std::string("solid x\nfacet normal oops\n"),
-                "cannot import"}),
+        BadMesh{"garbage", "g.stl", std::string("solid x\nfacet normal oops\n"), "cannot import"}),
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(ReadMesh, MissingFileIsNotFound) {

@@ -89,7 +89,8 @@ TEST(PlyRead, BigEndianBinary) {
   for (float v : {1.5f, -2.25f, 400.125f, 3.f, 4.f, 5.f}) body += BigEndianFloat(v);
   WriteBytes(dir.File("be.ply"),
              "ply\nformat binary_big_endian 1.0\nelement vertex 2\nproperty float x\n"
-             "property float y\nproperty float z\nend_header\n" + body);
+             "property float y\nproperty float z\nend_header\n" +
+                 body);
   auto c = ReadPointCloud(dir.File("be.ply"));
   ASSERT_TRUE(c.ok()) << c.status();
   ASSERT_EQ(c->size(), 2u);
@@ -120,8 +121,7 @@ struct Malformed {
   const char* message_part;
 };
 
-const std::string kPcdHead =
-    "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n";
+const std::string kPcdHead = "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n";
 
 std::vector<Malformed> MalformedClouds() {
   return {
@@ -141,8 +141,7 @@ std::vector<Malformed> MalformedClouds() {
       {"huge_count", "h.pcd",
        kPcdHead + "WIDTH 4000000000\nHEIGHT 1\nPOINTS 4000000000\nDATA binary\n",
        absl::StatusCode::kResourceExhausted, "limit"},
-      {"ascii_short", "a.pcd",
-       kPcdHead + "WIDTH 3\nHEIGHT 1\nPOINTS 3\nDATA ascii\n1 2 3\n4 5 6\n",
+      {"ascii_short", "a.pcd", kPcdHead + "WIDTH 3\nHEIGHT 1\nPOINTS 3\nDATA ascii\n1 2 3\n4 5 6\n",
        absl::StatusCode::kInvalidArgument, "2 data lines"},
       {"compressed_short", "c.pcd",
        kPcdHead + "WIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA binary_compressed\n" +
@@ -156,7 +155,8 @@ std::vector<Malformed> MalformedClouds() {
        absl::StatusCode::kInvalidArgument, "bad SIZE"},
       {"ply_truncated", "t.ply",
        "ply\nformat binary_little_endian 1.0\nelement vertex 10\nproperty float x\n"
-       "property float y\nproperty float z\nend_header\n" + std::string(12, '\0'),
+       "property float y\nproperty float z\nend_header\n" +
+           std::string(12, '\0'),
        absl::StatusCode::kInvalidArgument, "truncated"},
       {"ply_no_magic", "m.ply", "plx\nformat ascii 1.0\nend_header\n",
        absl::StatusCode::kInvalidArgument, "magic"},

@@ -24,10 +24,10 @@ TEST(IoTransform, RejectsMalformed) {
       "not json",
       "{\"matrix\": [[1,0,0],[0,1,0],[0,0,1]]}",
       "{\"matrix\": [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,2]]}",
-      "{\"matrix\": [[2,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}",     // scaled
-      "{\"matrix\": [[-1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}",    // reflection
+      "{\"matrix\": [[2,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}",   // scaled
+      "{\"matrix\": [[-1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}",  // reflection
       "{\"matrix\": [[1,0,0,\"a\"],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}",
-      "{\"matrix\": [[1,0,0,1e999],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}", // inf
+      "{\"matrix\": [[1,0,0,1e999],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}",  // inf
       "{\"rotation\": 1}",
   };
   for (const char* text : bad) EXPECT_FALSE(ParseTransformJson(text, "t.json").ok()) << text;
@@ -37,7 +37,8 @@ TEST(Transform, ComposeReadsLeftToRight) {
   Eigen::Isometry3d world_from_gauge = Eigen::Isometry3d::Identity();
   world_from_gauge.translation() = Eigen::Vector3d(100, 0, 0);
   Eigen::Isometry3d gauge_from_sensor = Eigen::Isometry3d::Identity();
-  gauge_from_sensor.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  gauge_from_sensor.linear() =
+      Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const Eigen::Vector3d p_sensor(1, 0, 0);
   const Eigen::Vector3d p_world = world_from_gauge * gauge_from_sensor * p_sensor;
   EXPECT_TRUE(p_world.isApprox(Eigen::Vector3d(100, 1, 0)));

@@ -34,22 +34,25 @@ struct Score {
 std::ostream& operator<<(std::ostream& os, const Score& s) {
   return os << "pulses " << s.pulses_removed << "/" << s.pulses << " removed ("
             << 100 * s.pulse_recall() << "%), stripes " << s.stripes_removed << "/" << s.stripes
-            << " (" << 100 * s.stripe_recall() << "%), good kept " << s.good_kept << "/"
-            << s.good << " (" << 100 * s.good_kept_ratio() << "%), defect kept "
-            << s.defect_kept << "/" << s.defect << " (" << 100 * s.defect_kept_ratio() << "%)";
+            << " (" << 100 * s.stripe_recall() << "%), good kept " << s.good_kept << "/" << s.good
+            << " (" << 100 * s.good_kept_ratio() << "%), defect kept " << s.defect_kept << "/"
+            << s.defect << " (" << 100 * s.defect_kept_ratio() << "%)";
 }
 
 // Defects planted where the clean scan sees the part: the pixel's point,
 // taken back to the part frame, lies on the CAD surface.
 std::vector<SurfaceDefect> PlantDefects(const DemoCell& cell, const DemoViewpoint& vp) {
-  auto clean = SimulateScan(cell.part, cell.world_from_part, vp.world_from_sensor,
-                            cell.intrinsics, {});
+  auto clean =
+      SimulateScan(cell.part, cell.world_from_part, vp.world_from_sensor, cell.intrinsics, {});
   EXPECT_TRUE(clean.ok());
   const Eigen::Isometry3d part_from_sensor = cell.world_from_part.inverse() * vp.world_from_sensor;
   // (row, col, depth mm, radius mm): the 0.05-0.5 mm and 3-8 mm,
   // one of them a bump.
-  const double plan[5][4] = {{384, 512, 0.05, 3.0}, {250, 300, 0.5, 3.0}, {520, 700, 0.2, 8.0},
-                             {300, 760, 0.35, 5.0}, {480, 260, -0.3, 6.0}};
+  const double plan[5][4] = {{384, 512, 0.05, 3.0},
+                             {250, 300, 0.5, 3.0},
+                             {520, 700, 0.2, 8.0},
+                             {300, 760, 0.35, 5.0},
+                             {480, 260, -0.3, 6.0}};
   std::vector<SurfaceDefect> defects;
   for (const auto& p : plan) {
     const std::size_t i = std::size_t(p[0]) * cell.intrinsics.width + std::size_t(p[1]);
@@ -69,11 +72,20 @@ Score ScoreFilter(const SimulatedScan& scan, const LinkClusteringResult& r) {
   for (std::size_t i = 0; i < scan.labels.size(); ++i) {
     const bool kept = r.kept_mask[i] != 0;
     switch (scan.labels[i]) {
-      case PixelLabel::kPulse: ++s.pulses, s.pulses_removed += !kept; break;
-      case PixelLabel::kStripe: ++s.stripes, s.stripes_removed += !kept; break;
-      case PixelLabel::kGood: ++s.good, s.good_kept += kept; break;
-      case PixelLabel::kDefect: ++s.defect, s.defect_kept += kept; break;
-      case PixelLabel::kNoData: break;
+      case PixelLabel::kPulse:
+        ++s.pulses, s.pulses_removed += !kept;
+        break;
+      case PixelLabel::kStripe:
+        ++s.stripes, s.stripes_removed += !kept;
+        break;
+      case PixelLabel::kGood:
+        ++s.good, s.good_kept += kept;
+        break;
+      case PixelLabel::kDefect:
+        ++s.defect, s.defect_kept += kept;
+        break;
+      case PixelLabel::kNoData:
+        break;
     }
   }
   return s;
@@ -94,8 +106,8 @@ class LinkClusteringGroundTruth : public ::testing::Test {
       opt.stripes = true;
       opt.defects = PlantDefects(cell, vp);
       opt.seed = 100 + v;
-      auto scan = SimulateScan(cell.part, cell.world_from_part, vp.world_from_sensor,
-                               cell.intrinsics, opt);
+      auto scan =
+          SimulateScan(cell.part, cell.world_from_part, vp.world_from_sensor, cell.intrinsics, opt);
       ASSERT_TRUE(scan.ok()) << scan.status();
       scans_->push_back(*std::move(scan));
     }

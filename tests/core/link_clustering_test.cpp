@@ -137,8 +137,8 @@ void ExpectConsistent(const PointCloud& c, const LinkClusteringResult& r,
     EXPECT_EQ(g.max_col, k.max_col);
     EXPECT_EQ(g.min, k.min);
     EXPECT_EQ(g.max, k.max);
-    const bool keep = k.size >= s.min_cluster_points &&
-                      k.size >= s.min_fraction_of_largest * largest;
+    const bool keep =
+        k.size >= s.min_cluster_points && k.size >= s.min_fraction_of_largest * largest;
     EXPECT_EQ(g.kept, keep) << "cluster " << id << " of " << k.size;
     if (keep) kept += k.size;
   }
@@ -185,8 +185,8 @@ TEST(LinkClusteringGrid, MatchesBfsOracleOnRandomGrids) {
       auto r = ClusterLinks(c, s);
       ASSERT_TRUE(r.ok()) << r.status();
       EXPECT_TRUE(r->organized_path);
-      SCOPED_TRACE(testing::Message() << "trial " << trial << " " << w << "x" << h << " conn "
-                                      << conn);
+      SCOPED_TRACE(testing::Message()
+                   << "trial " << trial << " " << w << "x" << h << " conn " << conn);
       ExpectSamePartition(r->labels, GridOracle(c, conn, LinkDistanceSquared(0.5)));
       ExpectConsistent(c, *r, s);
       if (HasFatalFailure()) return;
@@ -366,8 +366,8 @@ TEST(LinkClustering, ReusedResultEqualsFreshResult) {
   std::mt19937 rng(9);
   LinkClusteringResult reused;
   for (int i = 0; i < 6; ++i) {
-    const PointCloud c = i % 2 ? RandomGrid(rng, 30 - i, 20 + i, 0.1)
-                               : RandomCloud(rng, 200 + 50 * i, 0.5f);
+    const PointCloud c =
+        i % 2 ? RandomGrid(rng, 30 - i, 20 + i, 0.1) : RandomCloud(rng, 200 + 50 * i, 0.5f);
     ASSERT_TRUE(ClusterLinksInto(c, {}, reused).ok());
     auto fresh = ClusterLinks(c, {});
     ASSERT_TRUE(fresh.ok());
@@ -415,8 +415,7 @@ TEST(LinkClustering, BadInputGivesClearErrors) {
     auto r = ClusterLinks(c, s);
     ASSERT_FALSE(r.ok()) << words;
     EXPECT_EQ(r.status().code(), absl::StatusCode::kInvalidArgument);
-    EXPECT_NE(std::string(r.status().message()).find(words), std::string::npos)
-        << r.status();
+    EXPECT_NE(std::string(r.status().message()).find(words), std::string::npos) << r.status();
   };
   for (double d : {-0.5, 0.0, double(NAN), double(INFINITY), 1e300}) {
     LinkClusteringSettings s;
@@ -443,9 +442,9 @@ TEST(LinkClustering, BadInputGivesClearErrors) {
   inf_grid.points[6] = {1.f, INFINITY, 0.f};
   expect_error(inf_grid, {}, "infinite");
   // An infinity next to a NaN in the same point is still an infinity.
-  for (const Eigen::Vector3f& p : {Eigen::Vector3f(INFINITY, 0.f, NAN),
-                                   Eigen::Vector3f(NAN, NAN, -INFINITY),
-                                   Eigen::Vector3f(NAN, INFINITY, 2.f)}) {
+  for (const Eigen::Vector3f& p :
+       {Eigen::Vector3f(INFINITY, 0.f, NAN), Eigen::Vector3f(NAN, NAN, -INFINITY),
+        Eigen::Vector3f(NAN, INFINITY, 2.f)}) {
     PointCloud g = PointCloud::Organized(70, 3);  // the bad pixel in word 2
     g.points[2 * 70 + 66] = p;
     expect_error(g, {}, "infinite");

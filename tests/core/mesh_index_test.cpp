@@ -39,7 +39,8 @@ Brute BruteForce(const TriangleMesh& m, const Vector3d& p) {
       b.triangle = t;
       b.point = r.point;
     }
-    b.independent = std::min(b.independent, DistanceByProjection(p, V(m, tri[0]), V(m, tri[1]), V(m, tri[2])));
+    b.independent =
+        std::min(b.independent, DistanceByProjection(p, V(m, tri[0]), V(m, tri[1]), V(m, tri[2])));
   }
   return b;
 }
@@ -51,7 +52,8 @@ TriangleMesh RandomSoup(int n, uint64_t seed) {
   TriangleMesh m;
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3f c(centre(rng), centre(rng), centre(rng));
-    for (int k = 0; k < 3; ++k) m.vertices.push_back(c + Eigen::Vector3f(size(rng), size(rng), size(rng)));
+    for (int k = 0; k < 3; ++k)
+      m.vertices.push_back(c + Eigen::Vector3f(size(rng), size(rng), size(rng)));
     const auto b = static_cast<uint32_t>(3 * i);
     m.triangles.push_back({b, b + 1, b + 2});
   }
@@ -73,9 +75,9 @@ std::vector<Vector3d> OracleQueryPoints(const TriangleMesh& m, uint64_t seed) {
     const auto& tri = m.triangles[rng() % m.num_triangles()];
     const Vector3d a = V(m, tri[0]), bb = V(m, tri[1]), c = V(m, tri[2]);
     const double s = u(rng), t = u(rng) * (1 - s);
-    pts.push_back(a);                                  // on a vertex
-    pts.push_back(a + u(rng) * (bb - a));               // on an edge
-    pts.push_back(a + s * (bb - a) + t * (c - a));      // on the face
+    pts.push_back(a);                               // on a vertex
+    pts.push_back(a + u(rng) * (bb - a));           // on an edge
+    pts.push_back(a + s * (bb - a) + t * (c - a));  // on the face
   }
   return pts;
 }
@@ -138,12 +140,14 @@ TEST(MeshIndex, ClosestIsExactFarFromTheOrigin) {
   // A flat, axis-aligned sheet: the boxes are as tight as the triangles, and
   // points just above the grid lines have near-ties within 1e-4 mm. Without
   // the padding this finds a wrong triangle (checked).
-  TriangleMesh flat = testing::HeightField(0, 30, 0, 30, 31, 31, [](double, double) { return 0.0; });
+  TriangleMesh flat =
+      testing::HeightField(0, 30, 0, 30, 31, 31, [](double, double) { return 0.0; });
   for (auto& v : flat.vertices) v += offset;
   pts.clear();
   for (int i = 0; i < 1500; ++i) {
     const double x = std::floor(u(rng)) + near_edge(rng);
-    pts.push_back(offset.cast<double>() + Vector3d(i % 2 ? x : u(rng), i % 2 ? u(rng) : x, 0.2 * h(rng)));
+    pts.push_back(offset.cast<double>() +
+                  Vector3d(i % 2 ? x : u(rng), i % 2 ? u(rng) : x, 0.2 * h(rng)));
   }
   ExpectMatchesBruteForce(flat, pts);
 }
@@ -184,9 +188,12 @@ TEST(MeshIndex, SignAgreesWithTheWindingNumberOnClosedMeshes) {
   // The crumpled balls get most points: their saddle vertices are where an
   // unweighted normal sum fails (checked: it gives ~10 wrong signs here).
   const std::vector<std::pair<TriangleMesh, int>> meshes = {
-      {testing::Icosphere(30, 3), 500}, {testing::Torus(40, 12, 48, 24), 500},
+      {testing::Icosphere(30, 3), 500},
+      {testing::Torus(40, 12, 48, 24), 500},
       {testing::Box(Vector3d(-10, -20, -5), Vector3d(30, 10, 15)), 500},
-      {CrumpledBall(1), 3000}, {CrumpledBall(2), 3000}, {CrumpledBall(3), 3000},
+      {CrumpledBall(1), 3000},
+      {CrumpledBall(2), 3000},
+      {CrumpledBall(3), 3000},
       {CrumpledBall(4), 3000}};
   int checked = 0;
   for (std::size_t k = 0; k < meshes.size(); ++k) {
@@ -198,8 +205,8 @@ TEST(MeshIndex, SignAgreesWithTheWindingNumberOnClosedMeshes) {
       const ClosestPoint r = index->Closest(p);
       if (r.distance_mm <= 1e-6) continue;
       const bool inside = testing::WindingNumber(m, p) > 0.5;
-      EXPECT_EQ(r.signed_distance_mm < 0, inside) << "mesh " << k << " p " << p.transpose()
-                                                  << " feature " << static_cast<int>(r.feature);
+      EXPECT_EQ(r.signed_distance_mm < 0, inside)
+          << "mesh " << k << " p " << p.transpose() << " feature " << static_cast<int>(r.feature);
       ++checked;
     }
   }
@@ -289,7 +296,7 @@ TEST(MeshIndex, SignIsRightAtSharpSheetMetalFolds) {
     std::vector<P> polygon = fold.profile;
     polygon.insert(polygon.end(), fold.closure.begin(), fold.closure.end());
     for (std::size_t i = 1; i + 1 < fold.profile.size(); ++i)  // the bends
-      for (double y : {5.0, 5.5, 10.0, 13.25}) {                // on vertices and edges
+      for (double y : {5.0, 5.5, 10.0, 13.25}) {               // on vertices and edges
         const Vector3d bend(fold.profile[i].x(), y, fold.profile[i].y());
         const ClosestPoint on = index->Closest(bend);
         EXPECT_EQ(on.distance_mm, 0.0) << fold.name;
@@ -310,9 +317,9 @@ TEST(MeshIndex, SignIsRightAtSharpSheetMetalFolds) {
 TEST(MeshIndex, PyramidApexAndPitUseTheVertexPseudonormal) {
   for (double k : {0.3, 1.0, 4.0}) {
     for (double s : {-1.0, 1.0}) {  // apex (s = -1) and pit (s = +1)
-      const TriangleMesh m = testing::HeightField(-10, 10, -10, 10, 21, 21, [&](double x, double y) {
-        return s * k * std::max(std::abs(x), std::abs(y));
-      });
+      const TriangleMesh m = testing::HeightField(
+          -10, 10, -10, 10, 21, 21,
+          [&](double x, double y) { return s * k * std::max(std::abs(x), std::abs(y)); });
       auto index = BuildOrDie(m);
       ASSERT_TRUE(index);
       std::mt19937_64 rng(static_cast<uint64_t>(k * 10 + s));
@@ -357,10 +364,12 @@ TEST(MeshIndex, SignIsRightAtRandomFanVertices) {
       fan.vertices.push_back(centre + Eigen::Vector3f(10 * std::cos(az[i]), 10 * std::sin(az[i]),
                                                       10 * std::tan((u(rng) - 0.5) * 2.6)));
     for (int i = 0; i < k; ++i)
-      fan.triangles.push_back({0u, static_cast<uint32_t>(1 + i), static_cast<uint32_t>(1 + (i + 1) % k)});
+      fan.triangles.push_back(
+          {0u, static_cast<uint32_t>(1 + i), static_cast<uint32_t>(1 + (i + 1) % k)});
     const auto base = static_cast<uint32_t>(all.vertices.size());
     all.vertices.insert(all.vertices.end(), fan.vertices.begin(), fan.vertices.end());
-    for (const auto& t : fan.triangles) all.triangles.push_back({base + t[0], base + t[1], base + t[2]});
+    for (const auto& t : fan.triangles)
+      all.triangles.push_back({base + t[0], base + t[1], base + t[2]});
     fans.push_back(std::move(fan));
   }
   auto index = BuildOrDie(all);
@@ -369,11 +378,13 @@ TEST(MeshIndex, SignIsRightAtRandomFanVertices) {
   for (const TriangleMesh& fan : fans) {
     const Vector3d centre = V(fan, 0);
     for (int i = 0; i < 300; ++i) {
-      const Vector3d p = centre + (i % 2 ? 1e-3 : 0.3) * Vector3d(g(rng), g(rng), g(rng)).normalized();
+      const Vector3d p =
+          centre + (i % 2 ? 1e-3 : 0.3) * Vector3d(g(rng), g(rng), g(rng)).normalized();
       const ClosestPoint r = index->Closest(p);
       if (r.distance_mm <= 1e-6) continue;
       const double h = testing::MeshHeightAt(fan, p.x(), p.y());
-      EXPECT_EQ(r.signed_distance_mm > 0, p.z() > h) << p.transpose() << " feature " << static_cast<int>(r.feature);
+      EXPECT_EQ(r.signed_distance_mm > 0, p.z() > h)
+          << p.transpose() << " feature " << static_cast<int>(r.feature);
       ++checked;
       at_vertex += IsVertex(r.feature) ? 1 : 0;
     }
@@ -402,7 +413,9 @@ TEST(MeshIndex, UnweldedSoupStillSignsByTopology) {
     EXPECT_GT(index->Closest(corner + 0.1 * out).signed_distance_mm, 0);
     EXPECT_LT(index->Closest(corner - 0.1 * out).signed_distance_mm, 0);
     // Outside beyond one face but near the corner: still +.
-    EXPECT_GT(index->Closest(corner + Vector3d(0.2 * out.x(), 0.01 * out.y(), 0.01 * out.z())).signed_distance_mm, 0);
+    EXPECT_GT(index->Closest(corner + Vector3d(0.2 * out.x(), 0.01 * out.y(), 0.01 * out.z()))
+                  .signed_distance_mm,
+              0);
   }
 }
 
@@ -410,9 +423,9 @@ TEST(MeshIndex, DegenerateAndNonManifoldTrianglesDoNotBreakQueries) {
   TriangleMesh m = testing::HeightField(0, 10, 0, 10, 11, 11, [](double, double) { return 0.0; });
   const auto n = static_cast<uint32_t>(m.vertices.size());
   m.vertices.emplace_back(5, 5, 0);
-  m.triangles.push_back({0, 1, 2});   // a collinear sliver along y = 0
-  m.triangles.push_back({n, n, n});   // a point
-  m.triangles.push_back({12, 13, n}); // shares edge 12-13: now non-manifold
+  m.triangles.push_back({0, 1, 2});    // a collinear sliver along y = 0
+  m.triangles.push_back({n, n, n});    // a point
+  m.triangles.push_back({12, 13, n});  // shares edge 12-13: now non-manifold
   auto index = BuildOrDie(m);
   ASSERT_TRUE(index);
   EXPECT_EQ(index->info().degenerate_triangles, 2u);
@@ -492,9 +505,8 @@ void ExpectIdentical(const std::vector<ClosestPoint>& a, const std::vector<Close
 }
 
 TEST(MeshIndexBatch, OneAndManyThreadsAndCoherentStartGiveIdenticalResults) {
-  const TriangleMesh sheet = testing::HeightField(0, 30, 0, 20, 31, 21, [](double x, double y) {
-    return std::sin(x / 4) * std::cos(y / 3);
-  });
+  const TriangleMesh sheet = testing::HeightField(
+      0, 30, 0, 20, 31, 21, [](double x, double y) { return std::sin(x / 4) * std::cos(y / 3); });
   auto index = BuildOrDie(sheet);
   ASSERT_TRUE(index);
   const PointCloud organized = OrganizedCloudNear(sheet, 60, 40, 1);
@@ -540,7 +552,8 @@ TEST(MeshIndexBatch, OneAndManyThreadsAndCoherentStartGiveIdenticalResults) {
 TEST(MeshIndexBatch, CancelAndBadInput) {
   auto index = BuildOrDie(testing::Box(Vector3d::Zero(), Vector3d::Constant(10)));
   ASSERT_TRUE(index);
-  PointCloud cloud = PointCloud::Unorganized(std::vector<Eigen::Vector3f>(5000, Eigen::Vector3f(1, 2, 3)));
+  PointCloud cloud =
+      PointCloud::Unorganized(std::vector<Eigen::Vector3f>(5000, Eigen::Vector3f(1, 2, 3)));
   std::atomic<bool> cancel{true};
   EXPECT_EQ(QueryClosest(*index, cloud, Eigen::Isometry3d::Identity(), {}, &cancel).status().code(),
             absl::StatusCode::kCancelled);

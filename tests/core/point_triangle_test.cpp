@@ -43,7 +43,8 @@ TEST(PointTriangle, RandomTrianglesAndPointsMatchTheProjectionOracle) {
     const auto r = ClosestPointOnTriangle(p, a + offset, b + offset, c + offset);
     const double want = DistanceByProjection(p, a + offset, b + offset, c + offset);
     ExpectSameDistance(std::sqrt(r.squared_distance), want);
-    EXPECT_NEAR((p - r.point).squaredNorm(), r.squared_distance, 1e-12 * r.squared_distance + 1e-20);
+    EXPECT_NEAR((p - r.point).squaredNorm(), r.squared_distance,
+                1e-12 * r.squared_distance + 1e-20);
     ASSERT_TRUE(OnTriangle(r.point - offset, a, b, c)) << i;
   }
 }
@@ -89,7 +90,8 @@ TEST(PointTriangle, ReportsTheFeatureOfEachVoronoiRegion) {
 
 TEST(PointTriangle, PointsOnVerticesAndEdgesHaveZeroDistance) {
   const Vector3d a(1, 2, 3), b(4, 2, 3.5), c(2, 6, 2);
-  for (const Vector3d& p : {a, b, c}) EXPECT_EQ(ClosestPointOnTriangle(p, a, b, c).squared_distance, 0);
+  for (const Vector3d& p : {a, b, c})
+    EXPECT_EQ(ClosestPointOnTriangle(p, a, b, c).squared_distance, 0);
   for (double t : {0.0, 0.25, 0.5, 1.0}) {
     EXPECT_NEAR(ClosestPointOnTriangle(a + t * (b - a), a, b, c).squared_distance, 0, 1e-28);
     EXPECT_NEAR(ClosestPointOnTriangle(b + t * (c - b), a, b, c).squared_distance, 0, 1e-28);
@@ -107,7 +109,8 @@ TEST(PointTriangle, DegenerateTrianglesFallBackToSegments) {
     const Vector3d a = rv(), b = rv();
     const Vector3d p = rv();
     // Collinear, two coincident and all three coincident vertices.
-    const std::array<std::array<Vector3d, 3>, 3> cases{{{a, b, a + 0.3 * (b - a)}, {a, a, b}, {a, a, a}}};
+    const std::array<std::array<Vector3d, 3>, 3> cases{
+        {{a, b, a + 0.3 * (b - a)}, {a, a, b}, {a, a, a}}};
     for (const auto& t : cases) {
       const auto r = ClosestPointOnTriangle(p, t[0], t[1], t[2]);
       ASSERT_TRUE(std::isfinite(r.squared_distance));

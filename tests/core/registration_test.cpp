@@ -15,11 +15,11 @@ class Registration : public ::testing::Test {
     for (int v = 0; v < 3; ++v) {
       ScanOptions opt;
       opt.seed = 10 + v;
-      auto scan = SimulateScan(cell_.part, cell_.world_from_part, cell_.viewpoints[v].world_from_sensor,
-                               cell_.intrinsics, opt);
+      auto scan = SimulateScan(cell_.part, cell_.world_from_part,
+                               cell_.viewpoints[v].world_from_sensor, cell_.intrinsics, opt);
       ASSERT_TRUE(scan.ok());
-      views_.push_back({cell_.viewpoints[v].name, scan->cloud_in_sensor,
-                        cell_.viewpoints[v].world_from_sensor});
+      views_.push_back(
+          {cell_.viewpoints[v].name, scan->cloud_in_sensor, cell_.viewpoints[v].world_from_sensor});
     }
     auto index = MeshIndex::Build(cell_.part);
     ASSERT_TRUE(index.ok());
@@ -46,14 +46,16 @@ TEST_F(Registration, TrueCalibrationPutsEveryViewOnTheCad) {
   // Every merged point traces back to its pixel.
   for (std::size_t i = 0; i < merged->cloud_in_world.size(); i += 997) {
     const ViewScan& v = views_[merged->view_id[i]];
-    const Eigen::Vector3d back = v.world_from_sensor.inverse() * merged->cloud_in_world.points[i].cast<double>();
+    const Eigen::Vector3d back =
+        v.world_from_sensor.inverse() * merged->cloud_in_world.points[i].cast<double>();
     EXPECT_LT((back - v.cloud_in_sensor.points[merged->grid_index[i]].cast<double>()).norm(), 1e-3);
   }
 }
 
 TEST_F(Registration, BestFitFindsACommonOffsetAndReportsIt) {
   Eigen::Isometry3d offset = Eigen::Isometry3d::Identity();
-  offset.linear() = Eigen::AngleAxisd(0.05 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  offset.linear() =
+      Eigen::AngleAxisd(0.05 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
   offset.translation() = Eigen::Vector3d(0.3, -0.2, 0.4);
   std::vector<ViewScan> shifted = views_;
   for (auto& v : shifted) v.world_from_sensor = offset * v.world_from_sensor;

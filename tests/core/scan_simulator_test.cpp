@@ -20,7 +20,7 @@ TriangleMesh Plate(float half) {
 // Two plates at z = 0 (x < 0) and z = -20 (x >= 0): a step with a jump.
 TriangleMesh Step() {
   TriangleMesh m;
-  m.vertices = {{-100, -100, 0}, {0, -100, 0},  {0, 100, 0},  {-100, 100, 0},
+  m.vertices = {{-100, -100, 0}, {0, -100, 0},     {0, 100, 0},     {-100, 100, 0},
                 {0, -100, -20},  {100, -100, -20}, {100, 100, -20}, {0, 100, -20}};
   m.triangles = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}};
   return m;
@@ -62,7 +62,8 @@ TEST(ScanSimulator, PlanePointsLieOnPlaneAndFootprintIsAnalytic) {
       const Eigen::Vector3d o = part_from_sensor.translation();
       const Eigen::Vector3d x = o + (-o.z() / ray.z()) * ray;
       const bool inside = std::abs(x.x()) < half && std::abs(x.y()) < half;
-      const bool near_edge = std::abs(std::abs(x.x()) - half) < 1e-3 || std::abs(std::abs(x.y()) - half) < 1e-3;
+      const bool near_edge =
+          std::abs(std::abs(x.x()) - half) < 1e-3 || std::abs(std::abs(x.y()) - half) < 1e-3;
       const bool valid = PointCloud::IsValid(scan->cloud_in_sensor.points[i]);
       if (valid != inside && !near_edge) ++mismatches;
       if (!valid) continue;

@@ -24,8 +24,8 @@ PointCloud Grid(uint32_t w, uint32_t h) {
 TEST(CloudAssembler, ChunksOfAnySizeGiveTheSameCloud) {
   const PointCloud want = Grid(33, 17);
   const std::string bytes = Bytes(want);
-  for (std::size_t chunk : {std::size_t{1}, std::size_t{5}, std::size_t{12}, std::size_t{1000},
-                            bytes.size()}) {
+  for (std::size_t chunk :
+       {std::size_t{1}, std::size_t{5}, std::size_t{12}, std::size_t{1000}, bytes.size()}) {
     CloudAssembler a;
     a.Start(33, 17);
     EXPECT_EQ(a.expected_bytes(), bytes.size());

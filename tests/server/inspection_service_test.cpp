@@ -32,9 +32,9 @@ using Clock = std::chrono::steady_clock;
 
 struct Data {
   DemoCell cell = MakeDemoCell();
-  PointCloud gauge_scan;                 // viewpoint v1, sensor frame
-  std::vector<ViewScan> views;           // three part scans with true poses
-  PointCloud merged_world;               // their merge (for ErrorMap)
+  PointCloud gauge_scan;        // viewpoint v1, sensor frame
+  std::vector<ViewScan> views;  // three part scans with true poses
+  PointCloud merged_world;      // their merge (for ErrorMap)
 };
 
 const Data& TestData() {
@@ -46,14 +46,16 @@ const Data& TestData() {
     opt.stripes = true;
     const DemoViewpoint& v1 = data->cell.viewpoints[0];
     data->gauge_scan = SimulateScan(data->cell.gauge, v1.world_from_gauge, v1.world_from_sensor,
-                                    data->cell.intrinsics, opt)->cloud_in_sensor;
+                                    data->cell.intrinsics, opt)
+                           ->cloud_in_sensor;
     opt.defects = {SurfaceDefect{{-60, 5, 60 - 3 * 0.16}, 6, 0.2}};
     for (int v = 0; v < 3; ++v) {
       opt.seed = 7 + v;
       const DemoViewpoint& vp = data->cell.viewpoints[v];
       data->views.push_back({vp.name,
-                             SimulateScan(data->cell.part, data->cell.world_from_part, vp.world_from_sensor,
-                                          data->cell.intrinsics, opt)->cloud_in_sensor,
+                             SimulateScan(data->cell.part, data->cell.world_from_part,
+                                          vp.world_from_sensor, data->cell.intrinsics, opt)
+                                 ->cloud_in_sensor,
                              vp.world_from_sensor});
     }
     data->merged_world = RegisterToWorld(data->views)->cloud_in_world;
@@ -91,7 +93,8 @@ TEST(InspectionService, EveryRpcMatchesInProcess) {
   const PointCloud local_filtered =
       *ApplyFilter(d.views[0].cloud_in_sensor, *ClusterLinks(d.views[0].cloud_in_sensor, {}));
   ASSERT_EQ(fresp->cloud().xyz().size(), local_filtered.size() * 12);
-  EXPECT_EQ(0, std::memcmp(fresp->cloud().xyz().data(), local_filtered.points.data(), local_filtered.size() * 12));
+  EXPECT_EQ(0, std::memcmp(fresp->cloud().xyz().data(), local_filtered.points.data(),
+                           local_filtered.size() * 12));
 
   // Calibrate: identical pose (the gauge mesh is small next to the scan,
   // so the client sends it inline).
@@ -105,10 +108,12 @@ TEST(InspectionService, EveryRpcMatchesInProcess) {
   auto cresp = client->Calibrate(creq, d.cell.gauge);
   ASSERT_TRUE(cresp.ok()) << cresp.status();
   auto gauge_index = *MeshIndex::Build(d.cell.gauge);
-  const CalibrationResult local_cal =
-      *CalibrateViewpoint(*gauge_index, v1.world_from_gauge, d.gauge_scan, v1.nominal_world_from_sensor, cs);
+  const CalibrationResult local_cal = *CalibrateViewpoint(
+      *gauge_index, v1.world_from_gauge, d.gauge_scan, v1.nominal_world_from_sensor, cs);
   EXPECT_TRUE((wire::TransformFromProto(cresp->world_from_sensor(), "w")->matrix() -
-               local_cal.world_from_sensor.matrix()).cwiseAbs().maxCoeff() < 1e-12);
+               local_cal.world_from_sensor.matrix())
+                  .cwiseAbs()
+                  .maxCoeff() < 1e-12);
 
   // Register: the same merged points.
   v1::RegisterRequest rreq;
@@ -121,13 +126,15 @@ TEST(InspectionService, EveryRpcMatchesInProcess) {
   auto rresp = client->Register(rreq, nullptr);
   ASSERT_TRUE(rresp.ok()) << rresp.status();
   ASSERT_EQ(rresp->merged().width(), d.merged_world.size());
-  EXPECT_EQ(0, std::memcmp(rresp->merged().xyz().data(), d.merged_world.points.data(), d.merged_world.size() * 12));
+  EXPECT_EQ(0, std::memcmp(rresp->merged().xyz().data(), d.merged_world.points.data(),
+                           d.merged_world.size() * 12));
 
   // ErrorMap: same deviations, same report apart from timing.
   auto eresp = client->ErrorMap(ErrorMapRequest(d.merged_world), d.cell.part);
   ASSERT_TRUE(eresp.ok()) << eresp.status();
   auto part_index = *MeshIndex::Build(d.cell.part);
-  const ErrorMapResult local_map = *ComputeErrorMap(*part_index, d.merged_world, d.cell.world_from_part, {});
+  const ErrorMapResult local_map =
+      *ComputeErrorMap(*part_index, d.merged_world, d.cell.world_from_part, {});
   const std::vector<float> remote_dev = wire::UnpackFloats(eresp->deviations());
   ASSERT_EQ(remote_dev.size(), local_map.deviation_mm.size());
   std::size_t differing = 0;
@@ -164,7 +171,8 @@ TEST(InspectionService, EveryRpcMatchesInProcess) {
 class RawCalls {
  public:
   explicit RawCalls(const std::string& target)
-      : stub_(v1::InspectionService::NewStub(grpc::CreateChannel(target, grpc::InsecureChannelCredentials()))) {}
+      : stub_(v1::InspectionService::NewStub(
+            grpc::CreateChannel(target, grpc::InsecureChannelCredentials()))) {}
   template <typename Req, typename Resp, typename Fn>
   grpc::Status Call(Fn fn, const Req& req) {
     grpc::ClientContext ctx;
@@ -213,17 +221,22 @@ TEST(InspectionService, BadRequestsGetTheRightCodeAndTheServerStaysUp) {
   };
   cases.push_back({"empty cloud", {filter(cloud(0, 0, 0)), StatusCode::INVALID_ARGUMENT}});
   cases.push_back({"truncated xyz", {filter(cloud(10, 10, 1000)), StatusCode::INVALID_ARGUMENT}});
-  cases.push_back({"inf coordinate", {filter(cloud(4, 4, 192, INFINITY)), StatusCode::INVALID_ARGUMENT}});
-  cases.push_back({"too many points", {filter(cloud(5000, 5000, 12)), StatusCode::RESOURCE_EXHAUSTED}});
+  cases.push_back(
+      {"inf coordinate", {filter(cloud(4, 4, 192, INFINITY)), StatusCode::INVALID_ARGUMENT}});
+  cases.push_back(
+      {"too many points", {filter(cloud(5000, 5000, 12)), StatusCode::RESOURCE_EXHAUSTED}});
   v1::FilterSettings neg;
   neg.set_link_distance_mm(-1);
-  cases.push_back({"negative link distance", {filter(cloud(4, 4, 192), neg), StatusCode::INVALID_ARGUMENT}});
+  cases.push_back(
+      {"negative link distance", {filter(cloud(4, 4, 192), neg), StatusCode::INVALID_ARGUMENT}});
   v1::FilterSettings nan_link;
   nan_link.set_link_distance_mm(NAN);
-  cases.push_back({"NaN link distance", {filter(cloud(4, 4, 192), nan_link), StatusCode::INVALID_ARGUMENT}});
+  cases.push_back(
+      {"NaN link distance", {filter(cloud(4, 4, 192), nan_link), StatusCode::INVALID_ARGUMENT}});
   v1::FilterSettings conn;
   conn.set_connectivity(6);
-  cases.push_back({"connectivity 6", {filter(cloud(4, 4, 192), conn), StatusCode::INVALID_ARGUMENT}});
+  cases.push_back(
+      {"connectivity 6", {filter(cloud(4, 4, 192), conn), StatusCode::INVALID_ARGUMENT}});
 
   auto errormap = [&](v1::ErrorMapRequest r) {
     return raw.Call<v1::ErrorMapRequest, v1::ErrorMapResponse>(&S::ErrorMap, r);
@@ -240,7 +253,8 @@ TEST(InspectionService, BadRequestsGetTheRightCodeAndTheServerStaysUp) {
   cases.push_back({"unknown mesh hash", {errormap(unknown_hash), StatusCode::FAILED_PRECONDITION}});
   v1::ErrorMapRequest short_transform = em;
   short_transform.mutable_world_from_part()->mutable_row_major()->RemoveLast();
-  cases.push_back({"15-value transform", {errormap(short_transform), StatusCode::INVALID_ARGUMENT}});
+  cases.push_back(
+      {"15-value transform", {errormap(short_transform), StatusCode::INVALID_ARGUMENT}});
   v1::ErrorMapRequest scaled = em;
   scaled.mutable_world_from_part()->set_row_major(0, 2.0);
   cases.push_back({"non-rigid transform", {errormap(scaled), StatusCode::INVALID_ARGUMENT}});
@@ -249,12 +263,15 @@ TEST(InspectionService, BadRequestsGetTheRightCodeAndTheServerStaysUp) {
   const uint32_t huge = 999999999;
   std::memcpy(tris.data(), &huge, 4);
   bad_index.mutable_part()->mutable_inline_()->set_triangles(tris);
-  cases.push_back({"triangle index out of range", {errormap(bad_index), StatusCode::INVALID_ARGUMENT}});
+  cases.push_back(
+      {"triangle index out of range", {errormap(bad_index), StatusCode::INVALID_ARGUMENT}});
   v1::ErrorMapRequest degenerate = em;
   std::string verts(36, '\0');
   degenerate.mutable_part()->mutable_inline_()->set_vertices(verts);
-  degenerate.mutable_part()->mutable_inline_()->set_triangles(std::string("\0\0\0\0\1\0\0\0\2\0\0\0", 12));
-  cases.push_back({"only degenerate triangles", {errormap(degenerate), StatusCode::INVALID_ARGUMENT}});
+  degenerate.mutable_part()->mutable_inline_()->set_triangles(
+      std::string("\0\0\0\0\1\0\0\0\2\0\0\0", 12));
+  cases.push_back(
+      {"only degenerate triangles", {errormap(degenerate), StatusCode::INVALID_ARGUMENT}});
   v1::ErrorMapRequest ragged = em;
   ragged.mutable_part()->mutable_inline_()->set_vertices("12345");
   cases.push_back({"ragged vertex bytes", {errormap(ragged), StatusCode::INVALID_ARGUMENT}});
@@ -268,26 +285,33 @@ TEST(InspectionService, BadRequestsGetTheRightCodeAndTheServerStaysUp) {
   cases.push_back({"calibrate without initial pose",
                    {raw.Call<v1::CalibrateRequest, v1::CalibrateResponse>(&S::Calibrate, cal),
                     StatusCode::INVALID_ARGUMENT}});
-  cases.push_back({"register without views",
-                   {raw.Call<v1::RegisterRequest, v1::RegisterResponse>(&S::Register, v1::RegisterRequest{}),
-                    StatusCode::INVALID_ARGUMENT}});
+  cases.push_back(
+      {"register without views",
+       {raw.Call<v1::RegisterRequest, v1::RegisterResponse>(&S::Register, v1::RegisterRequest{}),
+        StatusCode::INVALID_ARGUMENT}});
 
   v1::InspectRequest part_msg, view_msg, chunk_msg, end_msg;
   part_msg.mutable_part()->set_part_id("x");
   *part_msg.mutable_part()->mutable_part()->mutable_inline_() = good_mesh;
-  wire::TransformToProto(Eigen::Isometry3d::Identity(), part_msg.mutable_part()->mutable_world_from_part());
+  wire::TransformToProto(Eigen::Isometry3d::Identity(),
+                         part_msg.mutable_part()->mutable_world_from_part());
   view_msg.mutable_view()->set_name("v1");
   view_msg.mutable_view()->set_width(2);
   view_msg.mutable_view()->set_height(2);
-  wire::TransformToProto(Eigen::Isometry3d::Identity(), view_msg.mutable_view()->mutable_world_from_sensor());
+  wire::TransformToProto(Eigen::Isometry3d::Identity(),
+                         view_msg.mutable_view()->mutable_world_from_sensor());
   chunk_msg.mutable_chunk()->set_xyz(std::string(24, '\0'));
   end_msg.mutable_end();
-  cases.push_back({"inspect: view before part", {raw.Inspect({view_msg}), StatusCode::INVALID_ARGUMENT}});
-  cases.push_back({"inspect: truncated view", {raw.Inspect({part_msg, view_msg, chunk_msg, end_msg}),
-                                               StatusCode::INVALID_ARGUMENT}});
-  cases.push_back({"inspect: no end marker", {raw.Inspect({part_msg}), StatusCode::INVALID_ARGUMENT}});
-  cases.push_back({"inspect: too many bytes", {raw.Inspect({part_msg, view_msg, chunk_msg, chunk_msg, chunk_msg}),
-                                               StatusCode::INVALID_ARGUMENT}});
+  cases.push_back(
+      {"inspect: view before part", {raw.Inspect({view_msg}), StatusCode::INVALID_ARGUMENT}});
+  cases.push_back(
+      {"inspect: truncated view",
+       {raw.Inspect({part_msg, view_msg, chunk_msg, end_msg}), StatusCode::INVALID_ARGUMENT}});
+  cases.push_back(
+      {"inspect: no end marker", {raw.Inspect({part_msg}), StatusCode::INVALID_ARGUMENT}});
+  cases.push_back({"inspect: too many bytes",
+                   {raw.Inspect({part_msg, view_msg, chunk_msg, chunk_msg, chunk_msg}),
+                    StatusCode::INVALID_ARGUMENT}});
 
   ASSERT_GE(cases.size(), 15u);
   for (const auto& [name, c] : cases) {
@@ -325,7 +349,8 @@ TEST(InspectionService, CancelledAndDeadlineExceededCallsStopPromptly) {
     v1::ErrorMapRequest req = ErrorMapRequest(big);
     req.mutable_part()->set_sha256(MeshSha256(d.cell.part));  // cached by the first call
     v1::ErrorMapResponse resp;
-    auto stub = v1::InspectionService::NewStub(grpc::CreateChannel(server.target(), grpc::InsecureChannelCredentials()));
+    auto stub = v1::InspectionService::NewStub(
+        grpc::CreateChannel(server.target(), grpc::InsecureChannelCredentials()));
     std::thread canceller;
     if (!use_deadline)
       canceller = std::thread([&] {
@@ -334,7 +359,8 @@ TEST(InspectionService, CancelledAndDeadlineExceededCallsStopPromptly) {
       });
     const grpc::Status st = stub->ErrorMap(&ctx, req, &resp);
     if (canceller.joinable()) canceller.join();
-    EXPECT_EQ(st.error_code(), use_deadline ? grpc::StatusCode::DEADLINE_EXCEEDED : grpc::StatusCode::CANCELLED);
+    EXPECT_EQ(st.error_code(),
+              use_deadline ? grpc::StatusCode::DEADLINE_EXCEEDED : grpc::StatusCode::CANCELLED);
     // The worker must be free again at once: a small call right after
     // finishes far sooner than the rest of the big one would have taken.
     const auto t1 = Clock::now();
@@ -372,9 +398,16 @@ TEST(InspectionService, EightClientsTwentyMixedCallsNoErrors) {
       for (int k = 0; k < 20; ++k) {
         absl::Status st;
         switch ((c + k) % 3) {
-          case 0: st = client->Filter(freq).status(); break;
-          case 1: st = client->ErrorMap(ErrorMapRequest(d.views[2].cloud_in_sensor), d.cell.part).status(); break;
-          default: st = client->Health().status(); break;
+          case 0:
+            st = client->Filter(freq).status();
+            break;
+          case 1:
+            st =
+                client->ErrorMap(ErrorMapRequest(d.views[2].cloud_in_sensor), d.cell.part).status();
+            break;
+          default:
+            st = client->Health().status();
+            break;
         }
         errors += st.ok() ? 0 : 1;
       }
@@ -394,7 +427,8 @@ TEST(InspectionService, GracefulShutdownFinishesTheCallInFlight) {
   v1::PartHeader header;
   header.set_part_id("drain");
   wire::TransformToProto(d.cell.world_from_part, header.mutable_world_from_part());
-  auto call = std::async(std::launch::async, [&] { return client->Inspect(header, d.cell.part, d.views); });
+  auto call =
+      std::async(std::launch::async, [&] { return client->Inspect(header, d.cell.part, d.views); });
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   const auto t0 = Clock::now();
   const int exit_code = server.Terminate();
@@ -415,7 +449,8 @@ TEST(InspectionService, BearerToken) {
   EXPECT_EQ(anonymous->Filter(req).status().code(), absl::StatusCode::kUnauthenticated);
   RemoteOptions wrong;
   wrong.auth_token = "guess";
-  EXPECT_EQ(ClientFor(server, wrong)->Filter(req).status().code(), absl::StatusCode::kUnauthenticated);
+  EXPECT_EQ(ClientFor(server, wrong)->Filter(req).status().code(),
+            absl::StatusCode::kUnauthenticated);
   RemoteOptions right;
   right.auth_token = "s3cret-token";
   EXPECT_TRUE(ClientFor(server, right)->Filter(req).ok());
@@ -438,9 +473,9 @@ void MakeCertificates(const testing::TempDir& dir) {
   };
   auto signed_by = [&](const std::string& name, const std::string& issuer, const std::string& ext) {
     return "openssl req -newkey rsa:2048 -nodes -subj /CN=" + name + " -keyout " + name +
-           ".key -out " + name + ".csr" + quiet + " && openssl x509 -req -in " + name + ".csr -CA " +
-           issuer + ".crt -CAkey " + issuer + ".key -CAcreateserial -days 2" + ext + " -out " + name +
-           ".crt" + quiet;
+           ".key -out " + name + ".csr" + quiet + " && openssl x509 -req -in " + name +
+           ".csr -CA " + issuer + ".crt -CAkey " + issuer + ".key -CAcreateserial -days 2" + ext +
+           " -out " + name + ".crt" + quiet;
   };
   const std::string cmd =
       "cd " + dir.path() + " && " + ca("ca") + " && " + ca("other-ca") +
@@ -453,7 +488,8 @@ void MakeCertificates(const testing::TempDir& dir) {
 TEST(InspectionService, TlsWithAGeneratedCertificate) {
   testing::TempDir dir;
   ASSERT_NO_FATAL_FAILURE(MakeCertificates(dir));
-  testing::ServerProcess server({"--tls-cert", dir.File("server.crt"), "--tls-key", dir.File("server.key")});
+  testing::ServerProcess server(
+      {"--tls-cert", dir.File("server.crt"), "--tls-key", dir.File("server.key")});
   ASSERT_TRUE(server.started());
   RemoteOptions tls;
   tls.tls_ca_file = dir.File("ca.crt");
@@ -550,17 +586,21 @@ TEST(InspectionService, PrometheusMetricsCountCallsPointsAndCache) {
   auto client = ClientFor(server);
   // A cloud much smaller than the mesh, so the client sends the mesh by hash
   // (a miss, then inline), then by hash again (a hit).
-  const PointCloud small = PointCloud::Unorganized(
-      std::vector<Eigen::Vector3f>(d.merged_world.points.begin(), d.merged_world.points.begin() + 500));
+  const PointCloud small = PointCloud::Unorganized(std::vector<Eigen::Vector3f>(
+      d.merged_world.points.begin(), d.merged_world.points.begin() + 500));
   ASSERT_TRUE(client->ErrorMap(ErrorMapRequest(small), d.cell.part).ok());
   ASSERT_TRUE(client->ErrorMap(ErrorMapRequest(small), d.cell.part).ok());
   v1::FilterRequest bad;
   EXPECT_FALSE(client->Filter(bad).ok());
   const std::string text = HttpGet(metrics_port, "/metrics");
-  EXPECT_NE(text.find("surfinspect_rpcs_total{code=\"OK\",method=\"ErrorMap\"} 2"), std::string::npos) << text;
-  EXPECT_NE(text.find("surfinspect_rpcs_total{code=\"INVALID_ARGUMENT\",method=\"Filter\"} 1"), std::string::npos);
+  EXPECT_NE(text.find("surfinspect_rpcs_total{code=\"OK\",method=\"ErrorMap\"} 2"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("surfinspect_rpcs_total{code=\"INVALID_ARGUMENT\",method=\"Filter\"} 1"),
+            std::string::npos);
   EXPECT_NE(text.find("surfinspect_mesh_cache_lookups_total{result=\"hit\"} 1"), std::string::npos);
-  EXPECT_NE(text.find("surfinspect_rpc_duration_seconds_count{method=\"ErrorMap\"} 3"), std::string::npos);
+  EXPECT_NE(text.find("surfinspect_rpc_duration_seconds_count{method=\"ErrorMap\"} 3"),
+            std::string::npos);
   EXPECT_NE(text.find("surfinspect_points_processed_total " + std::to_string(2 * small.size())),
             std::string::npos);
 }

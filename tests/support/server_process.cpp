@@ -49,8 +49,10 @@ ServerProcess::ServerProcess(const std::vector<std::string>& extra) {
   while (std::chrono::steady_clock::now() < deadline && line.find('\n') == std::string::npos) {
     char buf[256];
     const ssize_t r = ::read(out[0], buf, sizeof(buf));
-    if (r > 0) line.append(buf, static_cast<std::size_t>(r));
-    else std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    if (r > 0)
+      line.append(buf, static_cast<std::size_t>(r));
+    else
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   ::close(out[0]);
   const auto colon = line.rfind(':');

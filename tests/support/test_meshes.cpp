@@ -9,9 +9,9 @@ namespace surfinspect::testing {
 
 TriangleMesh Icosphere(double radius, int subdivisions) {
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Eigen::Vector3d> v = {{-1, t, 0}, {1, t, 0},  {-1, -t, 0}, {1, -t, 0},
-                                    {0, -1, t}, {0, 1, t},  {0, -1, -t}, {0, 1, -t},
-                                    {t, 0, -1}, {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<Eigen::Vector3d> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
+                                    {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
+                                    {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
   std::vector<Triangle> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
                              {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
                              {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
@@ -63,7 +63,8 @@ TriangleMesh Torus(double major_radius, double minor_radius, int major_segments,
 TriangleMesh Box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
   TriangleMesh m;
   for (int i = 0; i < 8; ++i)
-    m.vertices.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
+    m.vertices.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(),
+                            i & 4 ? hi.z() : lo.z());
   m.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
                  {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
   return m;
@@ -125,7 +126,8 @@ double MeshHeightAt(const TriangleMesh& mesh, double x, double y) {
     if (det == 0) continue;
     const double s = ((x - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (y - a.y())) / det;
     const double r = ((b.x() - a.x()) * (y - a.y()) - (x - a.x()) * (b.y() - a.y())) / det;
-    if (s >= -1e-12 && r >= -1e-12 && s + r <= 1 + 1e-12) return a.z() + s * (b.z() - a.z()) + r * (c.z() - a.z());
+    if (s >= -1e-12 && r >= -1e-12 && s + r <= 1 + 1e-12)
+      return a.z() + s * (b.z() - a.z()) + r * (c.z() - a.z());
   }
   return NAN;
 }
