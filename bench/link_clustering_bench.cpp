@@ -24,11 +24,11 @@
 #include <map>
 #include <random>
 
-#include "core/demo_cell.h"
-#include "core/link_clustering.h"
-#include "core/link_clustering_grid.h"
-#include "core/link_clustering_unorganized.h"
-#include "core/scan_simulator.h"
+#include "core/simulation/demo_cell.h"
+#include "core/filter/link_clustering.h"
+#include "core/filter/link_clustering_grid.h"
+#include "core/filter/link_clustering_unorganized.h"
+#include "core/simulation/scan_simulator.h"
 
 namespace {
 

@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "bench/wavy_sheet.h"
-#include "core/scan_simulator.h"
+#include "core/simulation/scan_simulator.h"
 
 namespace {
 

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "core/triangle_mesh.h"
+#include "core/types/triangle_mesh.h"
 
 namespace surfinspect::bench {
 

@@ -4,7 +4,7 @@
 #include <cstring>
 
 #include "absl/strings/str_cat.h"
-#include "core/transform.h"
+#include "core/types/transform.h"
 
 namespace surfinspect::wire {
 namespace {

@@ -9,11 +9,11 @@
 #include <string>
 
 #include "absl/status/statusor.h"
-#include "core/calibration.h"
-#include "core/error_map.h"
-#include "core/link_clustering.h"
-#include "core/point_cloud.h"
-#include "core/triangle_mesh.h"
+#include "core/registration/calibration.h"
+#include "core/errormap/error_map.h"
+#include "core/filter/link_clustering.h"
+#include "core/types/point_cloud.h"
+#include "core/types/triangle_mesh.h"
 #include "surfinspect/v1/inspection.pb.h"
 
 namespace surfinspect::wire {

@@ -1,7 +1,7 @@
 #include "server/inspect_reactor.h"
 
 #include "absl/strings/str_cat.h"
-#include "core/inspection.h"
+#include "core/pipeline/inspection.h"
 #include "server/status_mapping.h"
 
 namespace surfinspect::server {

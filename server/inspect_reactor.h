@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "core/registration.h"
+#include "core/registration/registration.h"
 #include "server/cancel_signal.h"
 #include "server/inspection_service.h"
 

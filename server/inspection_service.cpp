@@ -8,12 +8,12 @@
 #include <nlohmann/json.hpp>
 
 #include "absl/strings/str_cat.h"
-#include "core/calibration.h"
-#include "core/inspection.h"
-#include "core/link_clustering.h"
-#include "core/mesh_hash.h"
-#include "core/registration.h"
-#include "core/transform.h"
+#include "core/registration/calibration.h"
+#include "core/pipeline/inspection.h"
+#include "core/filter/link_clustering.h"
+#include "core/io/mesh_hash.h"
+#include "core/registration/registration.h"
+#include "core/types/transform.h"
 #include "server/cancel_signal.h"
 #include "server/status_mapping.h"
 

@@ -7,8 +7,9 @@
 #include <thread>
 
 #include "absl/strings/ascii.h"
-#include "core/atomic_file.h"
-#include "core/buffer_reuse.h"
+#include "core/io/atomic_file.h"
+#include "core/process/buffer_reuse.h"
+#include "core/process/quiet_consoles.h"
 #include "server/run_server.h"
 
 int main(int argc, char** argv) {
@@ -21,6 +22,7 @@ int main(int argc, char** argv) {
   sigaddset(&signals, SIGINT);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   surfinspect::ReuseFreedLargeBuffers();  // every call moves ~10 MB buffers
+  surfinspect::QuietDependencyConsoles();
   surfinspect::server::ServerOptions o;
   o.service.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   std::string token_file;

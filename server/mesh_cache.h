@@ -1,5 +1,5 @@
 // A byte-bounded LRU cache of built mesh indices keyed by the mesh's
-// content hash (core/mesh_hash.h). Keeps the service stateless in effect:
+// content hash (core/io/mesh_hash.h). Keeps the service stateless in effect:
 // a miss only costs the client one inline re-send, and any replica can
 // rebuild any entry. Thread-safe; entries are shared, so an index in use by
 // a running call survives its eviction.
@@ -11,7 +11,7 @@
 #include <string>
 #include <unordered_map>
 
-#include "core/mesh_index.h"
+#include "core/distance/mesh_index.h"
 
 namespace surfinspect::server {
 

@@ -11,7 +11,7 @@
 #include <thread>
 
 #include "absl/strings/str_cat.h"
-#include "core/atomic_file.h"
+#include "core/io/atomic_file.h"
 
 namespace surfinspect::server {
 namespace {

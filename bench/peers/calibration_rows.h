@@ -22,9 +22,9 @@
 #include <random>
 
 #include "bench/peers/report.h"
-#include "core/calibration.h"
-#include "core/demo_cell.h"
-#include "core/transform.h"
+#include "core/registration/calibration.h"
+#include "core/simulation/demo_cell.h"
+#include "core/types/transform.h"
 #ifdef SURFINSPECT_HAVE_OPEN3D
 #include <open3d/geometry/PointCloud.h>
 #include <open3d/pipelines/registration/Registration.h>

@@ -22,11 +22,11 @@
 #include <random>
 
 #include "bench/peers/report.h"
-#include "core/demo_cell.h"
-#include "core/link_clustering.h"
-#include "core/link_clustering_grid.h"
-#include "core/link_clustering_unorganized.h"
-#include "core/scan_simulator.h"
+#include "core/simulation/demo_cell.h"
+#include "core/filter/link_clustering.h"
+#include "core/filter/link_clustering_grid.h"
+#include "core/filter/link_clustering_unorganized.h"
+#include "core/simulation/scan_simulator.h"
 
 namespace surfinspect::bench {
 

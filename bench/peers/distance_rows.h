@@ -14,7 +14,7 @@
 #include <tuple>
 
 #include "bench/peers/report.h"
-#include "core/mesh_index.h"
+#include "core/distance/mesh_index.h"
 #ifdef SURFINSPECT_HAVE_OPEN3D
 #include <open3d/core/Tensor.h>
 #include <open3d/t/geometry/RaycastingScene.h>

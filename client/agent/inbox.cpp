@@ -4,7 +4,7 @@
 #include <filesystem>
 
 #include "absl/strings/str_cat.h"
-#include "core/atomic_file.h"
+#include "core/io/atomic_file.h"
 
 namespace surfinspect::client {
 namespace fs = std::filesystem;

@@ -24,10 +24,11 @@
 #include "client/cell/cell_config.h"
 #include "client/cell/part_outputs.h"
 #include "client/remote/remote_client.h"
-#include "core/atomic_file.h"
-#include "core/buffer_reuse.h"
-#include "core/io_mesh.h"
-#include "core/io_point_cloud.h"
+#include "core/io/atomic_file.h"
+#include "core/process/buffer_reuse.h"
+#include "core/process/quiet_consoles.h"
+#include "core/io/io_mesh.h"
+#include "core/io/io_point_cloud.h"
 #include "proto/convert.h"
 
 namespace surfinspect::client {
@@ -290,6 +291,7 @@ void AddConnection(CLI::App* cmd, AgentArgs& a) {
 int main(int argc, char** argv) {
   using namespace surfinspect::client;
   surfinspect::ReuseFreedLargeBuffers();  // clouds are ~10 MB buffers, over and over
+  surfinspect::QuietDependencyConsoles();
   spdlog::set_default_logger(spdlog::stderr_color_mt("cell-agent"));
   AgentArgs a;
   CLI::App app{"cell-agent: streams a robot cell's scans to surfinspectd and keeps the results"};

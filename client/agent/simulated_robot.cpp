@@ -4,11 +4,11 @@
 #include <random>
 
 #include "absl/strings/str_format.h"
-#include "core/atomic_file.h"
-#include "core/io_mesh.h"
-#include "core/io_point_cloud.h"
-#include "core/io_transform.h"
-#include "core/scan_simulator.h"
+#include "core/io/atomic_file.h"
+#include "core/io/io_mesh.h"
+#include "core/io/io_point_cloud.h"
+#include "core/io/io_transform.h"
+#include "core/simulation/scan_simulator.h"
 
 namespace surfinspect::client {
 namespace fs = std::filesystem;

@@ -3,8 +3,8 @@
 #include <filesystem>
 
 #include "absl/strings/str_cat.h"
-#include "core/atomic_file.h"
-#include "core/io_transform.h"
+#include "core/io/atomic_file.h"
+#include "core/io/io_transform.h"
 
 namespace surfinspect::client {
 namespace {

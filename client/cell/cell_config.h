@@ -19,9 +19,9 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/error_map.h"
-#include "core/inspection.h"
-#include "core/link_clustering.h"
+#include "core/errormap/error_map.h"
+#include "core/pipeline/inspection.h"
+#include "core/filter/link_clustering.h"
 
 namespace surfinspect::client {
 

@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/inspection.h"
-#include "core/point_cloud.h"
+#include "core/pipeline/inspection.h"
+#include "core/types/point_cloud.h"
 #include "surfinspect/v1/inspection.pb.h"
 
 namespace surfinspect::client {

@@ -9,10 +9,10 @@
 
 #include "client/cli/commands.h"
 #include "client/cli/remote_args.h"
-#include "core/atomic_file.h"
-#include "core/io_point_cloud.h"
-#include "core/link_clustering.h"
-#include "core/png_image.h"
+#include "core/io/atomic_file.h"
+#include "core/io/io_point_cloud.h"
+#include "core/filter/link_clustering.h"
+#include "core/io/png_image.h"
 #include "proto/convert.h"
 
 namespace surfinspect::cli {

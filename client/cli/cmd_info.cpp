@@ -3,8 +3,8 @@
 
 #include "absl/strings/ascii.h"
 #include "client/cli/commands.h"
-#include "core/io_mesh.h"
-#include "core/io_point_cloud.h"
+#include "core/io/io_mesh.h"
+#include "core/io/io_point_cloud.h"
 
 namespace surfinspect::cli {
 namespace {

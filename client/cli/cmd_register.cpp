@@ -4,9 +4,9 @@
 
 #include "client/cli/commands.h"
 #include "client/cli/remote_args.h"
-#include "core/io_point_cloud.h"
-#include "core/io_transform.h"
-#include "core/registration.h"
+#include "core/io/io_point_cloud.h"
+#include "core/io/io_transform.h"
+#include "core/registration/registration.h"
 #include "proto/convert.h"
 
 namespace surfinspect::cli {

@@ -8,11 +8,11 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_split.h"
 #include "client/cli/commands.h"
-#include "core/atomic_file.h"
-#include "core/demo_cell.h"
-#include "core/io_mesh.h"
-#include "core/io_point_cloud.h"
-#include "core/io_transform.h"
+#include "core/io/atomic_file.h"
+#include "core/simulation/demo_cell.h"
+#include "core/io/io_mesh.h"
+#include "core/io/io_point_cloud.h"
+#include "core/io/io_transform.h"
 
 namespace surfinspect::cli {
 namespace {

@@ -2,7 +2,7 @@
 
 #include "absl/strings/ascii.h"
 #include "client/cli/commands.h"
-#include "core/atomic_file.h"
+#include "core/io/atomic_file.h"
 
 namespace surfinspect::cli {
 

@@ -6,8 +6,8 @@
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
-#include "core/atomic_file.h"
-#include "core/mesh_hash.h"
+#include "core/io/atomic_file.h"
+#include "core/io/mesh_hash.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "proto/convert.h"
 

@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/registration.h"
-#include "core/triangle_mesh.h"
+#include "core/registration/registration.h"
+#include "core/types/triangle_mesh.h"
 #include "surfinspect/v1/inspection.grpc.pb.h"
 
 namespace surfinspect::client {

@@ -5,7 +5,7 @@
 #include <Eigen/Core>
 #include <functional>
 
-#include "core/triangle_mesh.h"
+#include "core/types/triangle_mesh.h"
 
 namespace surfinspect::testing {
 

@@ -1,0 +1,274 @@
+#include "core/distance/mesh_index.h"
+
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <tuple>
+
+#include "absl/strings/str_cat.h"
+#include "core/distance/embree_handles.h"
+
+namespace surfinspect {
+namespace {
+
+// Embree culls nodes in float, with the query point rounded to float
+// (relative error 2^-24 per coordinate). Padding the radius well beyond that
+// keeps the true minimiser and every exact tie inside the search, so the
+// double-precision answer is the brute-force answer.
+float SearchRadius(double distance_mm, double coordinate_scale) {
+  if (!(distance_mm < static_cast<double>(std::numeric_limits<float>::max()) / 2)) return INFINITY;
+  const double padded = distance_mm * (1 + 1e-6) + 1e-6 * coordinate_scale + 1e-9;
+  return std::nextafter(static_cast<float>(padded), INFINITY);
+}
+
+struct QueryState {
+  Eigen::Vector3d p;
+  const Eigen::Vector3f* vertices;
+  const Triangle* triangles;
+  const Eigen::Vector3d* face_normals;
+  double coordinate_scale;
+  double best_d2;  // the squared limit until a triangle is accepted
+  uint32_t best_triangle = UINT32_MAX;
+  PointTriangleResult best;
+
+  // Keeps the lexicographic minimum of (squared distance, triangle id), so
+  // the answer does not depend on the order triangles are offered in.
+  bool Offer(uint32_t t) {
+    const Triangle& tri = triangles[t];
+    const Eigen::Vector3d a = vertices[tri[0]].cast<double>();
+    // The distance to the triangle's plane is a lower bound on the distance
+    // to the triangle: one dot product rejects most candidates. The slack,
+    // far above the rounding of either computation, keeps exact ties
+    // (points on shared edges and vertices) for the full test below.
+    const Eigen::Vector3d pa = p - a;
+    const double below = std::abs(pa.dot(face_normals[t])) - 1e-12 * pa.lpNorm<1>();
+    if (below > 0 && below * below > best_d2) return false;
+    const PointTriangleResult r = ClosestPointOnTriangle(p, a, vertices[tri[1]].cast<double>(),
+                                                         vertices[tri[2]].cast<double>());
+    const bool better =
+        best_triangle == UINT32_MAX
+            ? r.squared_distance <= best_d2
+            : r.squared_distance < best_d2 || (r.squared_distance == best_d2 && t < best_triangle);
+    if (!better) return false;
+    best = r;
+    best_d2 = r.squared_distance;
+    best_triangle = t;
+    return true;
+  }
+};
+
+// Called by Embree for every triangle whose bounds meet the query sphere;
+// shrinks the radius after an improvement and returns true when it did, as
+// Embree asks.
+
+bool OnCandidate(RTCPointQueryFunctionArguments* args) {
+  auto& s = *static_cast<QueryState*>(args->userPtr);
+  if (!s.Offer(args->primID)) return false;
+  const float radius = SearchRadius(std::sqrt(s.best_d2), s.coordinate_scale);
+  if (!(radius < args->query->radius)) return false;
+  args->query->radius = radius;
+  return true;
+}
+
+bool OnEmbreeMemory(void* counter, ssize_t bytes, bool /*post*/) {
+  static_cast<std::atomic<int64_t>*>(counter)->fetch_add(bytes, std::memory_order_relaxed);
+  return true;
+}
+
+RTCBuildQuality ToEmbree(BvhQuality q) {
+  switch (q) {
+    case BvhQuality::kLow:
+      return RTC_BUILD_QUALITY_LOW;
+    case BvhQuality::kMedium:
+      return RTC_BUILD_QUALITY_MEDIUM;
+    case BvhQuality::kHigh:
+      break;
+  }
+  return RTC_BUILD_QUALITY_HIGH;
+}
+
+// Interior angle at `v` between the edges to `u` and `w` (radians).
+double Angle(const Eigen::Vector3d& v, const Eigen::Vector3d& u, const Eigen::Vector3d& w) {
+  const Eigen::Vector3d a = u - v, b = w - v;
+  return std::atan2(a.cross(b).norm(), a.dot(b));
+}
+
+}  // namespace
+
+MeshIndex::~MeshIndex() = default;
+
+absl::StatusOr<std::unique_ptr<MeshIndex>> MeshIndex::Build(TriangleMesh mesh,
+                                                            const MeshIndexSettings& settings) {
+  if (settings.build_threads < 0)
+    return absl::InvalidArgumentError(
+        absl::StrCat("mesh index: build_threads must be >= 0, got ", settings.build_threads));
+  if (auto st = mesh.Validate(); !st.ok()) return st;
+  if (mesh.triangles.size() >= UINT32_MAX || mesh.vertices.size() >= UINT32_MAX)
+    return absl::InvalidArgumentError("mesh index: more than 2^32-1 triangles or vertices");
+  const auto start = std::chrono::steady_clock::now();
+  std::unique_ptr<MeshIndex> index(new MeshIndex());
+  index->embree_bytes_ = std::make_unique<std::atomic<int64_t>>(0);
+  auto device = EmbreeDevice::Create();
+  if (!device.ok()) return device.status();
+  index->device_ = *std::move(device);
+  rtcSetDeviceMemoryMonitorFunction(index->device_->get(), &OnEmbreeMemory,
+                                    index->embree_bytes_.get());
+  // Embree builds with TBB; an arena bounds the build's threads without a
+  // process-global limit (Embree's own "threads=" config sets one).
+  tbb::task_arena arena(settings.build_threads > 0 ? settings.build_threads
+                                                   : tbb::task_arena::automatic);
+  absl::StatusOr<std::unique_ptr<EmbreeTriangleScene>> scene;
+  arena.execute([&] {
+    scene = EmbreeTriangleScene::Build(index->device_, mesh, ToEmbree(settings.build_quality));
+  });
+  if (!scene.ok()) return scene.status();
+  index->scene_ = *std::move(scene);
+  index->mesh_ = std::move(mesh);
+  index->ComputePseudonormals();
+  index->info_.triangles = index->mesh_.num_triangles();
+  index->info_.build_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return index;
+}
+
+void MeshIndex::ComputePseudonormals() {
+  const auto& verts = mesh_.vertices;
+  const auto& tris = mesh_.triangles;
+  // Weld identical positions (an STL from elsewhere may repeat them) so the
+  // adjacency, and with it the edge and vertex pseudonormals, is right.
+  std::vector<uint32_t> order(verts.size());
+  std::iota(order.begin(), order.end(), 0u);
+  auto key = [&](uint32_t i) {
+    return std::make_tuple(verts[i].x(), verts[i].y(), verts[i].z(), i);
+  };
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return key(a) < key(b); });
+  weld_.resize(verts.size());
+  for (std::size_t i = 0; i < order.size();) {
+    std::size_t j = i;
+    while (j < order.size() && verts[order[j]] == verts[order[i]]) weld_[order[j++]] = order[i];
+    info_.welded_vertices += j - i - 1;
+    i = j;
+  }
+
+  face_normal_.assign(tris.size(), Eigen::Vector3d::Zero());
+  for (std::size_t t = 0; t < tris.size(); ++t) {
+    if (mesh_.IsDegenerate(t)) {
+      ++info_.degenerate_triangles;
+      continue;  // a zero normal: contributes nothing to its neighbours' sums
+    }
+    const Eigen::Vector3d a = verts[tris[t][0]].cast<double>(),
+                          b = verts[tris[t][1]].cast<double>(),
+                          c = verts[tris[t][2]].cast<double>();
+    face_normal_[t] = (b - a).cross(c - a).normalized();
+  }
+
+  // Edges: sort (welded vertex pair, slot) and sum the face normals per run.
+  std::vector<std::pair<uint64_t, uint32_t>> slots;
+  slots.reserve(tris.size() * 3);
+  for (std::size_t t = 0; t < tris.size(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      uint32_t u = weld_[tris[t][k]], w = weld_[tris[t][(k + 1) % 3]];
+      if (u > w) std::swap(u, w);
+      slots.emplace_back((uint64_t{u} << 32) | w, static_cast<uint32_t>(t * 3 + k));
+    }
+  std::sort(slots.begin(), slots.end());
+  triangle_edges_.resize(tris.size());
+  edge_normal_.clear();
+  for (std::size_t i = 0; i < slots.size();) {
+    std::size_t j = i;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    const auto id = static_cast<uint32_t>(edge_normal_.size());
+    for (; j < slots.size() && slots[j].first == slots[i].first; ++j) {
+      sum += face_normal_[slots[j].second / 3];
+      triangle_edges_[slots[j].second / 3][slots[j].second % 3] = id;
+    }
+    if (j - i == 1) ++info_.boundary_edges;
+    if (j - i >= 3) ++info_.nonmanifold_edges;
+    edge_normal_.push_back(sum.norm() > 0 ? Eigen::Vector3d(sum.normalized()) : sum);
+    i = j;
+  }
+
+  // Vertices: each incident face normal weighted by its angle at the vertex.
+  vertex_normal_.assign(verts.size(), Eigen::Vector3d::Zero());
+  for (std::size_t t = 0; t < tris.size(); ++t) {
+    if (face_normal_[t].isZero()) continue;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d v = verts[tris[t][k]].cast<double>();
+      const Eigen::Vector3d u = verts[tris[t][(k + 1) % 3]].cast<double>();
+      const Eigen::Vector3d w = verts[tris[t][(k + 2) % 3]].cast<double>();
+      vertex_normal_[weld_[tris[t][k]]] += Angle(v, u, w) * face_normal_[t];
+    }
+  }
+  for (auto& n : vertex_normal_)
+    if (n.norm() > 0) n.normalize();
+}
+
+const Eigen::Vector3d& MeshIndex::Pseudonormal(uint32_t triangle, ClosestFeature feature) const {
+  const int k = FeatureIndex(feature);
+  if (IsEdge(feature)) return edge_normal_[triangle_edges_[triangle][k]];
+  if (IsVertex(feature)) return vertex_normal_[weld_[mesh_.triangles[triangle][k]]];
+  return face_normal_[triangle];
+}
+
+ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_distance_mm,
+                                uint32_t hint_triangle) const {
+  ClosestPoint out;
+  if (!p_in_mesh.allFinite() || !(max_distance_mm >= 0)) return out;
+  QueryState s{p_in_mesh,
+               mesh_.vertices.data(),
+               mesh_.triangles.data(),
+               face_normal_.data(),
+               p_in_mesh.cwiseAbs().maxCoeff(),
+               max_distance_mm * max_distance_mm,
+               UINT32_MAX,
+               {}};
+  // A good first candidate (the previous point's triangle) starts the
+  // search with a nearly exact radius; the result is the same without it.
+  if (hint_triangle < mesh_.num_triangles()) s.Offer(hint_triangle);
+  RTCPointQuery query;
+  query.x = static_cast<float>(p_in_mesh.x());
+  query.y = static_cast<float>(p_in_mesh.y());
+  query.z = static_cast<float>(p_in_mesh.z());
+  query.time = 0.f;
+  query.radius = SearchRadius(
+      s.best_triangle == UINT32_MAX ? max_distance_mm : std::sqrt(s.best_d2), s.coordinate_scale);
+  // Beyond float range Embree cannot place the point; such a point is unmatched.
+  if (!std::isfinite(query.x) || !std::isfinite(query.y) || !std::isfinite(query.z)) return out;
+  RTCPointQueryContext context;
+  rtcInitPointQueryContext(&context);
+  rtcPointQuery(scene_->get(), &query, &context, &OnCandidate, &s);
+  if (s.best_triangle == UINT32_MAX) return out;
+
+  const uint32_t t = s.best_triangle;
+  out.triangle_id = t;
+  out.point = s.best.point;
+  out.feature = s.best.feature;
+  out.distance_mm = std::sqrt(s.best.squared_distance);
+  out.normal = face_normal_[t];
+  // Bærentzen & Aanæs: sign((p - c) . n) with n the closest feature's
+  // pseudonormal. A zero (a fold flat onto itself) falls back to the face.
+  const Eigen::Vector3d diff = p_in_mesh - out.point;
+  double side = diff.dot(Pseudonormal(t, out.feature));
+  if (side == 0) side = diff.dot(face_normal_[t]);
+  out.signed_distance_mm = side < 0 ? -out.distance_mm : out.distance_mm;
+  return out;
+}
+
+absl::Status MeshIndex::TakeDeviceError() const { return device_->TakeError(); }
+
+std::size_t MeshIndex::memory_bytes() const {
+  const int64_t embree = embree_bytes_ ? embree_bytes_->load(std::memory_order_relaxed) : 0;
+  return sizeof(*this) + mesh_.vertices.capacity() * sizeof(Eigen::Vector3f) +
+         mesh_.triangles.capacity() * sizeof(Triangle) +
+         face_normal_.capacity() * sizeof(Eigen::Vector3d) +
+         triangle_edges_.capacity() * sizeof(triangle_edges_[0]) +
+         edge_normal_.capacity() * sizeof(Eigen::Vector3d) + weld_.capacity() * sizeof(uint32_t) +
+         vertex_normal_.capacity() * sizeof(Eigen::Vector3d) +
+         static_cast<std::size_t>(std::max<int64_t>(embree, 0));
+}
+
+}  // namespace surfinspect

@@ -1,0 +1,152 @@
+// MeshIndex: exact closest-point and signed-distance queries against a CAD
+// mesh, the core of the error map (paper §IV, steps 1-4).
+//
+// An Embree 3 BVH culls the triangles; each candidate triangle is answered by
+// the double-precision kernel in core/distance/point_triangle.h, and the callback
+// shrinks the query radius so traversal prunes as it goes (Embree's
+// closest_point tutorial). Ties between equally close triangles go to the
+// lower triangle id, so an answer never depends on traversal order, start
+// radius or thread count.
+//
+// Sign: the angle-weighted pseudonormal of the closest feature (Bærentzen &
+// Aanæs, "Signed distance computation using the angle weighted
+// pseudonormal", IEEE TVCG 2005): the face normal inside a face, the sum of
+// the adjacent face normals on an edge, the incident-angle-weighted sum at a
+// vertex. This is the paper's step 4 (points whose closest point lies on a
+// shared boundary). A boundary edge of an open mesh has one face and uses its
+// normal; no ray parity is involved, so open sheet-metal surfaces sign right.
+// + is the side the CCW face normal points to (above the material), - below.
+//
+// Batch queries over whole clouds are declared here too and live in
+// core/distance/mesh_index_batch.cpp.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "absl/functional/function_ref.h"
+#include "absl/status/statusor.h"
+#include "core/types/point_cloud.h"
+#include "core/distance/point_triangle.h"
+#include "core/types/triangle_mesh.h"
+
+namespace surfinspect {
+
+class EmbreeDevice;
+class EmbreeTriangleScene;
+
+struct ClosestPoint {
+  uint32_t triangle_id = UINT32_MAX;  // UINT32_MAX = unmatched
+  Eigen::Vector3d point =
+      Eigen::Vector3d::Constant(NAN);  // closest point on the mesh, mm, mesh frame
+  ClosestFeature feature = ClosestFeature::kFace;
+  double distance_mm = NAN;         // unsigned; NaN if unmatched
+  double signed_distance_mm = NAN;  // + on the CCW-normal side; NaN if unmatched
+  Eigen::Vector3d normal =
+      Eigen::Vector3d::Zero();  // unit face normal of triangle_id (0 if degenerate)
+  bool matched() const { return triangle_id != UINT32_MAX; }
+};
+
+enum class BvhQuality { kLow, kMedium, kHigh };
+
+struct MeshIndexSettings {
+  // Embree's build quality: kHigh builds slower (spatial splits) and answers
+  // faster; worth it for meshes queried with millions of points.
+  BvhQuality build_quality = BvhQuality::kHigh;
+  int build_threads = 0;  // Embree build threads; 0 = all cores
+};
+
+// What Build() found in the mesh; reported with the error map.
+struct MeshIndexInfo {
+  std::size_t triangles = 0;
+  std::size_t degenerate_triangles = 0;  // kept in the BVH, but never signed by their own normal
+  std::size_t boundary_edges = 0;        // open mesh when > 0
+  std::size_t nonmanifold_edges = 0;
+  std::size_t welded_vertices = 0;  // duplicate vertex positions merged for the pseudonormals
+  double build_seconds = 0;
+};
+
+class MeshIndex {
+ public:
+  // Fails (InvalidArgument) on a mesh that TriangleMesh::Validate rejects,
+  // or with Embree's error turned into a status.
+  static absl::StatusOr<std::unique_ptr<MeshIndex>> Build(TriangleMesh mesh,
+                                                          const MeshIndexSettings& settings = {});
+  ~MeshIndex();
+  MeshIndex(const MeshIndex&) = delete;
+  MeshIndex& operator=(const MeshIndex&) = delete;
+
+  // The closest point on the mesh to `p_in_mesh` (mm, mesh frame) if it lies
+  // within `max_distance_mm` (inclusive), otherwise unmatched. A non-finite
+  // point is unmatched. `hint_triangle`, a triangle likely to be close (the
+  // previous scan point's), only speeds the search up: the answer is the
+  // same with any hint or none. Thread-safe.
+  ClosestPoint Closest(const Eigen::Vector3d& p_in_mesh, double max_distance_mm = INFINITY,
+                       uint32_t hint_triangle = UINT32_MAX) const;
+
+  // Embree reports failures through the device's error callback, not
+  // through rtcPointQuery: this returns (and clears) any error recorded
+  // since the last call. The batch queries check it when they finish.
+  absl::Status TakeDeviceError() const;
+
+  const TriangleMesh& mesh() const { return mesh_; }
+  const MeshIndexInfo& info() const { return info_; }
+  // Mesh, pseudonormals and Embree's BVH (measured through Embree's memory
+  // monitor), for an LRU cache of indices.
+  std::size_t memory_bytes() const;
+
+ private:
+  MeshIndex() = default;
+  void ComputePseudonormals();
+  const Eigen::Vector3d& Pseudonormal(uint32_t triangle, ClosestFeature feature) const;
+
+  TriangleMesh mesh_;
+  MeshIndexInfo info_;
+  std::vector<Eigen::Vector3d> face_normal_;             // per triangle, unit or 0
+  std::vector<std::array<uint32_t, 3>> triangle_edges_;  // per triangle: edge ids of AB, BC, CA
+  std::vector<Eigen::Vector3d> edge_normal_;             // per edge: sum of adjacent face normals
+  std::vector<uint32_t> weld_;                           // vertex -> representative vertex
+  std::vector<Eigen::Vector3d> vertex_normal_;           // per representative: angle-weighted sum
+  // Declared before the Embree handles so it outlives them: Embree reports
+  // its frees to the monitor while the device is released.
+  std::unique_ptr<std::atomic<int64_t>> embree_bytes_;
+  std::shared_ptr<EmbreeDevice> device_;
+  std::unique_ptr<EmbreeTriangleScene> scene_;
+};
+
+struct BatchQuerySettings {
+  double max_distance_mm = INFINITY;  // points farther from the mesh are unmatched (NaN)
+  int threads = 0;                    // 0 = all cores; results do not depend on it
+  // Exploit coherence: visit points in a spatially coherent order (the
+  // sensor grid for organized clouds, Morton order otherwise) and start each
+  // query's radius at previous distance + |p - p_prev| (triangle
+  // inequality), so traversal prunes from the first node. Results are
+  // identical with and without it; only the speed differs.
+  bool coherent_start = true;
+};
+
+// One result per input point, in input order. Points are transformed by
+// `mesh_from_points` first; invalid (NaN) points give unmatched results.
+// `cancel` (may be null) is polled every chunk of points -> CancelledError.
+// InvalidArgument for a malformed cloud or bad settings.
+absl::StatusOr<std::vector<ClosestPoint>> QueryClosest(const MeshIndex& index,
+                                                       const PointCloud& points,
+                                                       const Eigen::Isometry3d& mesh_from_points,
+                                                       const BatchQuerySettings& settings,
+                                                       const std::atomic<bool>* cancel = nullptr);
+
+// The same, streaming: `sink(i, result)` is called exactly once for every
+// input index i, concurrently from worker threads (for different i), so
+// callers can store only the fields they need.
+absl::Status QueryClosestEach(const MeshIndex& index, const PointCloud& points,
+                              const Eigen::Isometry3d& mesh_from_points,
+                              const BatchQuerySettings& settings, const std::atomic<bool>* cancel,
+                              absl::FunctionRef<void(std::size_t, const ClosestPoint&)> sink);
+
+}  // namespace surfinspect

@@ -1,0 +1,42 @@
+// Files an inspector opens from an error map: a coloured binary PLY (the
+// `deviation` property loads as a scalar field in CloudCompare and MeshLab),
+// a CSV with one row per input point, and a JSON report shared by the CLI
+// and the server. Every file is written atomically. The PNG picture is in
+// core/errormap/error_map_png.h.
+#pragma once
+
+#include <nlohmann/json_fwd.hpp>
+#include <string>
+
+#include "absl/status/status.h"
+#include "core/errormap/error_map.h"
+#include "core/io/png_image.h"
+#include "core/types/point_cloud.h"
+
+namespace surfinspect {
+
+// The diverging colour scale, centred on 0 (paper Fig. 11: red above the CAD
+// surface, blue below): green inside +-tolerance (tinted warm/cool by sign),
+// yellow -> red from +tol to +range, cyan -> blue from -tol to -range, darker
+// still beyond the range, grey for NaN (unmatched).
+Rgb DeviationColor(double deviation_mm, double tolerance_mm, double range_mm);
+inline constexpr Rgb kUnmatchedGrey{150, 150, 150};
+
+// Binary little-endian PLY of the finite points of `points` (whatever frame
+// the caller chose; say it in `frame_name`, stored as a comment), each with
+// float x y z, float deviation (mm, NaN when unmatched) and uchar red green
+// blue from DeviationColor. Fails if the sizes of points and result differ.
+absl::Status WriteErrorMapPly(const std::string& path, const PointCloud& points,
+                              const ErrorMapResult& result, const std::string& frame_name);
+
+// CSV with header x,y,z,deviation (plus dx,dy,dz,normal_deviation when the
+// result has split components), one row per input point in input order,
+// `nan` where a value is missing. Floats are printed round-trip exact.
+absl::Status WriteErrorMapCsv(const std::string& path, const PointCloud& points,
+                              const ErrorMapResult& result);
+
+// The report: settings, point counts, statistics, tolerance verdict,
+// histogram, optional component statistics and timing. NaN becomes null.
+nlohmann::json ErrorMapReportJson(const ErrorMapResult& result, const ErrorMapSettings& settings);
+
+}  // namespace surfinspect

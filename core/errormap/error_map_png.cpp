@@ -1,0 +1,175 @@
+#include "core/errormap/error_map_png.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "core/errormap/error_map_output.h"
+
+namespace surfinspect {
+namespace {
+
+constexpr Rgb kWhite{255, 255, 255};
+constexpr Rgb kBlack{0, 0, 0};
+constexpr uint32_t kMinMapPixels = 400;  // small grids are enlarged to at least this
+constexpr int kPanelWidth = 310;
+constexpr int kMinHeight = 520;
+
+Rgb Color(const ErrorMapResult& r, double d) {
+  return DeviationColor(d, r.tolerance_mm, r.color_range_mm);
+}
+
+// Organized: the sensor grid, block-averaged down (or enlarged by an integer
+// factor) to fit. A block with valid but unmatched points is grey.
+RgbImage GridMap(const PointCloud& pts, const ErrorMapResult& r, uint32_t max_px) {
+  const uint32_t longest = std::max(pts.width, pts.height);
+  const uint32_t step = std::max<uint32_t>(1, (longest + max_px - 1) / max_px);
+  const uint32_t w = (pts.width + step - 1) / step, h = (pts.height + step - 1) / step;
+  const uint32_t zoom = std::max<uint32_t>(1, kMinMapPixels / std::max(w, h));
+  RgbImage img(w * zoom, h * zoom, kWhite);
+  for (uint32_t by = 0; by < h; ++by)
+    for (uint32_t bx = 0; bx < w; ++bx) {
+      double sum = 0;
+      int matched = 0, valid = 0;
+      for (uint32_t y = by * step; y < std::min(pts.height, (by + 1) * step); ++y)
+        for (uint32_t x = bx * step; x < std::min(pts.width, (bx + 1) * step); ++x) {
+          const std::size_t i = std::size_t{y} * pts.width + x;
+          if (!PointCloud::IsValid(pts.points[i])) continue;
+          ++valid;
+          if (std::isnan(r.deviation_mm[i])) continue;
+          sum += r.deviation_mm[i];
+          ++matched;
+        }
+      if (valid == 0) continue;
+      const Rgb c = matched ? Color(r, sum / matched) : kUnmatchedGrey;
+      img.FillRect(static_cast<int>(bx * zoom), static_cast<int>(by * zoom), static_cast<int>(zoom),
+                   static_cast<int>(zoom), c);
+    }
+  return img;
+}
+
+// Unorganized: orthographic along -axis, image right = u, up = v (a right-
+// handed u, v, axis triple), the point nearest the viewer wins each pixel.
+// The pixel size follows the point density so a dense scan has no gaps.
+RgbImage OrthoMap(const PointCloud& pts, const ErrorMapResult& r, int axis, uint32_t max_px) {
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  const Bounds3 b = ComputeBounds(pts);
+  if (b.empty()) return RgbImage(kMinMapPixels, kMinMapPixels, kWhite);
+  const double eu = std::max(b.max[u] - b.min[u], 1e-9), ev = std::max(b.max[v] - b.min[v], 1e-9);
+  const double n = static_cast<double>(std::max<std::size_t>(1, pts.CountValid()));
+  const double pixel =
+      std::max({std::max(eu, ev) / max_px, std::sqrt(eu * ev / n), std::max(eu, ev) / 4000.0});
+  const auto w = static_cast<uint32_t>(eu / pixel) + 1, h = static_cast<uint32_t>(ev / pixel) + 1;
+  const uint32_t zoom = std::max<uint32_t>(1, kMinMapPixels / std::max(w, h));
+  RgbImage img(w * zoom, h * zoom, kWhite);
+  std::vector<float> depth(std::size_t{w} * h, -INFINITY);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const Eigen::Vector3f& p = pts.points[i];
+    if (!PointCloud::IsValid(p)) continue;
+    const auto x = static_cast<uint32_t>((p[u] - b.min[u]) / pixel);
+    const auto y = h - 1 - static_cast<uint32_t>((p[v] - b.min[v]) / pixel);
+    float& z = depth[std::size_t{y} * w + x];
+    if (p[axis] <= z) continue;
+    z = p[axis];
+    img.FillRect(static_cast<int>(x * zoom), static_cast<int>(y * zoom), static_cast<int>(zoom),
+                 static_cast<int>(zoom), Color(r, r.deviation_mm[i]));
+  }
+  return img;
+}
+
+std::string Label(double v, double range) {
+  const int decimals = range >= 10 ? 1 : range >= 1 ? 2 : range >= 0.01 ? 3 : 4;
+  return absl::StrFormat("%+.*f", decimals, v);
+}
+
+// Verdict text, colour bar with labels, and the histogram on the same
+// vertical deviation axis, drawn at x0.
+void DrawPanel(RgbImage& img, int x0, const ErrorMapResult& r) {
+  const Verdict& v = r.verdict;
+  img.DrawText(x0 + 10, 10, v.pass ? "pass" : "fail", v.pass ? Rgb{0, 140, 0} : Rgb{200, 0, 0}, 3);
+  const double range = r.color_range_mm;
+  img.DrawText(x0 + 10, 40, absl::StrCat("tol +-", Label(r.tolerance_mm, range).substr(1), " mm"),
+               kBlack, 2);
+  img.DrawText(x0 + 10, 58,
+               absl::StrFormat("in tol %.2f%%",
+                               100 * (std::isnan(v.fraction_within) ? 0 : v.fraction_within)),
+               kBlack, 2);
+  img.DrawText(x0 + 10, 76, absl::StrCat("rms ", Label(r.stats.rms_mm, range).substr(1), " mm"),
+               kBlack, 2);
+  img.DrawText(x0 + 10, 94, absl::StrCat("n ", r.stats.matched, "/", r.stats.valid), kBlack, 2);
+
+  const int top = 140, bottom = static_cast<int>(img.height) - 30, bar_x = x0 + 14;
+  const double span = bottom - top;
+  auto y_of = [&](double d) {
+    return top + static_cast<int>(std::lround((range - d) / (2 * range) * span));
+  };
+  img.DrawText(bar_x, top - 26, "mm", kBlack, 2);
+  img.FillRect(bar_x, top - 8, 22, 6, Color(r, 2 * range));  // beyond the scale
+  img.FillRect(bar_x, bottom + 2, 22, 6, Color(r, -2 * range));
+  for (int y = top; y < bottom; ++y)
+    img.FillRect(bar_x, y, 22, 1, Color(r, range - (y - top + 0.5) / span * 2 * range));
+  std::vector<double> ticks = {range, 0.0, -range};
+  if (r.tolerance_mm < range && y_of(r.tolerance_mm) - y_of(range) > 16 &&
+      y_of(0) - y_of(r.tolerance_mm) > 16)
+    ticks.insert(ticks.end(), {r.tolerance_mm, -r.tolerance_mm});
+  for (double t : ticks) {
+    const int y = y_of(t);
+    img.FillRect(bar_x + 22, y, 6, 1, kBlack);
+    img.DrawText(bar_x + 30, y - 7, Label(t, range), kBlack, 2);
+  }
+
+  const Histogram& h = r.histogram;
+  const int hist_x = x0 + 130, hist_w = kPanelWidth - 140;
+  const std::size_t peak =
+      h.counts.empty() ? 0 : *std::max_element(h.counts.begin(), h.counts.end());
+  img.FillRect(hist_x - 1, top, 1, bottom - top, kBlack);  // the axis
+  for (std::size_t k = 0; k < h.counts.size() && peak > 0; ++k) {
+    const double lo = h.min_mm + k * h.bin_width_mm(), hi = lo + h.bin_width_mm();
+    const int y_top = y_of(hi), y_bottom = std::max(y_of(lo), y_top + 1);
+    const int len = static_cast<int>(std::lround(static_cast<double>(h.counts[k]) / peak * hist_w));
+    img.FillRect(hist_x, y_top, len, y_bottom - y_top, Color(r, 0.5 * (lo + hi)));
+  }
+}
+
+}  // namespace
+
+int ThinnestAxis(const Bounds3& b) {
+  if (b.empty()) return 2;
+  const Eigen::Vector3d e = b.max - b.min;
+  int axis = 2;
+  for (int a : {1, 0})
+    if (e[a] < e[axis]) axis = a;
+  return axis;
+}
+
+absl::StatusOr<RgbImage> RenderErrorMap(const PointCloud& points, const ErrorMapResult& result,
+                                        const Bounds3& mesh_bounds,
+                                        const ErrorMapPngOptions& options) {
+  if (result.deviation_mm.size() != points.size())
+    return absl::InvalidArgumentError("error map png: result does not belong to these points");
+  if (options.view_axis < -1 || options.view_axis > 2)
+    return absl::InvalidArgumentError(
+        absl::StrCat("error map png: view_axis must be -1, 0, 1 or 2, got ", options.view_axis));
+  if (options.max_map_pixels < 16 || options.max_map_pixels > 20000)
+    return absl::InvalidArgumentError("error map png: max_map_pixels must be in [16, 20000]");
+  if (!(result.color_range_mm > 0))
+    return absl::InvalidArgumentError("error map png: the result has no colour range");
+  const int axis = options.view_axis >= 0 ? options.view_axis : ThinnestAxis(mesh_bounds);
+  const RgbImage map = points.organized() ? GridMap(points, result, options.max_map_pixels)
+                                          : OrthoMap(points, result, axis, options.max_map_pixels);
+  RgbImage img(map.width + kPanelWidth, std::max<uint32_t>(map.height, kMinHeight), kWhite);
+  for (uint32_t y = 0; y < map.height; ++y) std::copy_n(&map.at(0, y), map.width, &img.at(0, y));
+  DrawPanel(img, static_cast<int>(map.width), result);
+  return img;
+}
+
+absl::Status WriteErrorMapPng(const std::string& path, const PointCloud& points,
+                              const ErrorMapResult& result, const Bounds3& mesh_bounds,
+                              const ErrorMapPngOptions& options) {
+  auto img = RenderErrorMap(points, result, mesh_bounds, options);
+  if (!img.ok()) return img.status();
+  return WritePng(path, *img);
+}
+
+}  // namespace surfinspect

@@ -1,0 +1,39 @@
+// The error-map picture (paper Fig. 11): the coloured map, a colour bar with
+// mm labels at +-range, +-tolerance and 0, the histogram beside it on the
+// same deviation axis, and the verdict. An organized cloud is drawn in its
+// sensor grid; a merged (unorganized) cloud as an orthographic view along an
+// axis, by default the CAD's thinnest extent (a sheet-metal part seen from
+// above), nearest point per pixel.
+#pragma once
+
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "core/errormap/error_map.h"
+#include "core/io/png_image.h"
+#include "core/types/point_cloud.h"
+
+namespace surfinspect {
+
+struct ErrorMapPngOptions {
+  // Unorganized clouds: look along -axis (0 = x, 1 = y, 2 = z), i.e. from
+  // the + side; -1 = the thinnest extent of `mesh_bounds`.
+  int view_axis = -1;
+  uint32_t max_map_pixels = 1000;  // longest side of the map panel
+};
+
+// Index of the smallest extent of `b` (0, 1 or 2); 2 for empty bounds.
+int ThinnestAxis(const Bounds3& b);
+
+// `points` are the cloud the result was computed for, in the frame of
+// `mesh_bounds` (the part frame) so the view axis means what it says.
+absl::StatusOr<RgbImage> RenderErrorMap(const PointCloud& points, const ErrorMapResult& result,
+                                        const Bounds3& mesh_bounds,
+                                        const ErrorMapPngOptions& options = {});
+
+// RenderErrorMap, then WritePng (atomic).
+absl::Status WriteErrorMapPng(const std::string& path, const PointCloud& points,
+                              const ErrorMapResult& result, const Bounds3& mesh_bounds,
+                              const ErrorMapPngOptions& options = {});
+
+}  // namespace surfinspect

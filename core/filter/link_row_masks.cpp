@@ -1,0 +1,152 @@
+#include "core/filter/link_row_masks.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/filter/link_clustering.h"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace surfinspect::link_row {
+
+// Copies w points into the SoA row (SSE2: 4 points = 3 loads, 7 shuffles).
+void Transpose(const Eigen::Vector3f* pts, uint32_t w, RowSoA& row) {
+  float* __restrict x = row.c(0);
+  float* __restrict y = row.c(1);
+  float* __restrict z = row.c(2);
+  const float* f = pts[0].data();
+  uint32_t i = 0;
+#if defined(__SSE2__)
+  for (; i + 4 <= w; i += 4, f += 12) {
+    const __m128 a = _mm_loadu_ps(f), b = _mm_loadu_ps(f + 4), c = _mm_loadu_ps(f + 8);
+    _mm_storeu_ps(x + i, _mm_shuffle_ps(a, _mm_shuffle_ps(b, c, _MM_SHUFFLE(1, 1, 2, 2)),
+                                        _MM_SHUFFLE(2, 0, 3, 0)));
+    _mm_storeu_ps(y + i, _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(0, 0, 1, 1)),
+                                        _mm_shuffle_ps(b, c, _MM_SHUFFLE(2, 2, 3, 3)),
+                                        _MM_SHUFFLE(2, 0, 2, 0)));
+    _mm_storeu_ps(z + i, _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(1, 1, 2, 2)),
+                                        _mm_shuffle_ps(c, c, _MM_SHUFFLE(3, 3, 0, 0)),
+                                        _MM_SHUFFLE(2, 0, 2, 0)));
+  }
+#endif
+  for (; i < w; ++i, f += 3) x[i] = f[0], y[i] = f[1], z[i] = f[2];
+}
+
+namespace {
+
+#if defined(__SSE2__)
+// 4 link tests at once, the float operations of PointsLinked in its order.
+inline uint64_t Link4(__m128 px, __m128 py, __m128 pz, const float* bx, const float* by,
+                      const float* bz, __m128 r2) {
+  const __m128 dx = _mm_sub_ps(px, _mm_loadu_ps(bx));
+  const __m128 dy = _mm_sub_ps(py, _mm_loadu_ps(by));
+  const __m128 dz = _mm_sub_ps(pz, _mm_loadu_ps(bz));
+  const __m128 d2 =
+      _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+  return static_cast<uint64_t>(_mm_movemask_ps(_mm_cmple_ps(d2, r2)));
+}
+#endif
+
+// One pass over a row in SoA form: valid bits (all coordinates finite, as
+// 0 * NaN and 0 * inf are NaN), west links and, with a row above, north
+// (and north-west / north-east) links; NaN never links. Returns whether an
+// infinite coordinate was seen, which the cloud contract forbids.
+template <bool kAbove, bool kDiagonals>
+bool RowBits(const RowSoA& cur, const RowSoA& up, uint32_t words, float r2, const RowMasks& m) {
+  const float *x = cur.c(0), *y = cur.c(1), *z = cur.c(2);
+  const float *ux = up.c(0), *uy = up.c(1), *uz = up.c(2);
+#if defined(__SSE2__)
+  const __m128 zero = _mm_setzero_ps(), inf = _mm_set1_ps(INFINITY), r = _mm_set1_ps(r2);
+  const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+  __m128 any_inf = zero;
+  for (uint32_t k = 0; k < words; ++k) {
+    uint64_t valid = 0, west = 0, north_west = 0, north = 0, north_east = 0;
+    for (uint32_t j = 0; j < 64; j += 4) {
+      const uint32_t i = 64 * k + j;
+      const __m128 px = _mm_loadu_ps(x + i), py = _mm_loadu_ps(y + i), pz = _mm_loadu_ps(z + i);
+      const __m128 s =
+          _mm_add_ps(_mm_add_ps(_mm_mul_ps(px, zero), _mm_mul_ps(py, zero)), _mm_mul_ps(pz, zero));
+      valid |= uint64_t(_mm_movemask_ps(_mm_cmpeq_ps(s, zero))) << j;
+      any_inf = _mm_or_ps(any_inf, _mm_or_ps(_mm_cmpeq_ps(_mm_and_ps(px, abs_mask), inf),
+                                             _mm_cmpeq_ps(_mm_and_ps(py, abs_mask), inf)));
+      any_inf = _mm_or_ps(any_inf, _mm_cmpeq_ps(_mm_and_ps(pz, abs_mask), inf));
+      west |= Link4(px, py, pz, x + i - 1, y + i - 1, z + i - 1, r) << j;
+      if (kAbove) north |= Link4(px, py, pz, ux + i, uy + i, uz + i, r) << j;
+      if (kDiagonals) {
+        north_west |= Link4(px, py, pz, ux + i - 1, uy + i - 1, uz + i - 1, r) << j;
+        north_east |= Link4(px, py, pz, ux + i + 1, uy + i + 1, uz + i + 1, r) << j;
+      }
+    }
+    m.valid[k] = valid, m.west[k] = west;
+    m.north_west[k] = north_west, m.north[k] = north, m.north_east[k] = north_east;
+  }
+  return _mm_movemask_ps(any_inf) != 0;
+#else
+  bool any_inf = false;
+  // Neighbours through shifted pointers: index i - 1 would wrap at i = 0.
+  auto at = [](const float* a, const float* b, const float* c, int shift, uint32_t i) {
+    return Eigen::Vector3f((a + shift)[i], (b + shift)[i], (c + shift)[i]);
+  };
+  for (uint32_t k = 0; k < words; ++k) {
+    uint64_t valid = 0, west = 0, north_west = 0, north = 0, north_east = 0;
+    for (uint32_t j = 0; j < 64; ++j) {
+      const uint32_t i = 64 * k + j;
+      const Eigen::Vector3f q = at(x, y, z, 0, i);
+      valid |= uint64_t(q.x() * 0.f + q.y() * 0.f + q.z() * 0.f == 0.f) << j;
+      any_inf |= q.array().isInf().any();
+      west |= uint64_t(PointsLinked(q, at(x, y, z, -1, i), r2)) << j;
+      if (kAbove) north |= uint64_t(PointsLinked(q, at(ux, uy, uz, 0, i), r2)) << j;
+      if (kDiagonals) {
+        north_west |= uint64_t(PointsLinked(q, at(ux, uy, uz, -1, i), r2)) << j;
+        north_east |= uint64_t(PointsLinked(q, at(ux, uy, uz, 1, i), r2)) << j;
+      }
+    }
+    m.valid[k] = valid, m.west[k] = west;
+    m.north_west[k] = north_west, m.north[k] = north, m.north_east[k] = north_east;
+  }
+  return any_inf;
+#endif
+}
+
+}  // namespace
+
+bool ComputeMasks(const RowSoA& cur, const RowSoA* up, bool diagonals, uint32_t words,
+                  float link_distance_sq, const RowMasks& masks) {
+  if (!up) return RowBits<false, false>(cur, cur, words, link_distance_sq, masks);
+  if (diagonals) return RowBits<true, true>(cur, *up, words, link_distance_sq, masks);
+  return RowBits<true, false>(cur, *up, words, link_distance_sq, masks);
+}
+
+// Bounds of the (all valid) pixels first..last of the row.
+void Bounds(const RowSoA& row, uint32_t first, uint32_t last, float lo_out[3], float hi_out[3]) {
+  for (int a = 0; a < 3; ++a) {
+    const float* v = row.c(a);
+    uint32_t i = first;
+    float lo = v[i], hi = v[i];
+#if defined(__SSE2__)
+    if (last - first >= 7) {
+      __m128 vlo = _mm_loadu_ps(v + i), vhi = vlo;
+      for (i += 4; i + 3 <= last; i += 4) {
+        const __m128 q = _mm_loadu_ps(v + i);
+        vlo = _mm_min_ps(vlo, q);
+        vhi = _mm_max_ps(vhi, q);
+      }
+      alignas(16) float l[4], h[4];
+      _mm_store_ps(l, vlo);
+      _mm_store_ps(h, vhi);
+      lo = std::min(std::min(l[0], l[1]), std::min(l[2], l[3]));
+      hi = std::max(std::max(h[0], h[1]), std::max(h[2], h[3]));
+    }
+#endif
+    for (; i <= last; ++i) {
+      lo = std::min(lo, v[i]);
+      hi = std::max(hi, v[i]);
+    }
+    lo_out[a] = lo;
+    hi_out[a] = hi;
+  }
+}
+
+}  // namespace surfinspect::link_row

@@ -1,0 +1,67 @@
+#include "core/pipeline/inspection.h"
+
+#include <nlohmann/json.hpp>
+
+#include "absl/strings/str_cat.h"
+#include "core/types/cancel.h"
+#include "core/errormap/error_map_output.h"
+#include "core/errormap/error_map_png.h"
+#include "core/types/transform.h"
+
+namespace surfinspect {
+
+absl::StatusOr<InspectionResult> InspectPart(const MeshIndex& part,
+                                             const Eigen::Isometry3d& world_from_part,
+                                             std::vector<ViewScan> views,
+                                             const InspectionSettings& settings,
+                                             const InspectionProgress& progress,
+                                             const std::atomic<bool>* cancel) {
+  if (views.empty()) return absl::InvalidArgumentError("inspect: no views");
+  InspectionResult out;
+  LinkClusteringResult clusters;  // buffers reused across views
+  for (ViewScan& v : views) {
+    ViewOutcome outcome;
+    outcome.name = v.name;
+    outcome.valid_points = v.cloud_in_sensor.CountValid();
+    if (settings.filter) {
+      if (auto st = ClusterLinksInto(v.cloud_in_sensor, settings.filter_settings, clusters, cancel);
+          !st.ok())
+        return absl::Status(st.code(), absl::StrCat("view '", v.name, "': ", st.message()));
+      auto cleaned = ApplyFilter(v.cloud_in_sensor, clusters);
+      if (!cleaned.ok()) return cleaned.status();
+      v.cloud_in_sensor = *std::move(cleaned);
+      outcome.removed_points = clusters.removed;
+      if (progress) progress(InspectionStage::kViewFiltered, v.name, clusters.kept);
+    }
+    out.views.push_back(outcome);
+  }
+  auto merged = RegisterToWorld(views);
+  if (!merged.ok()) return merged.status();
+  out.merged = *std::move(merged);
+  if (progress)
+    for (std::size_t k = 0; k < views.size(); ++k)
+      progress(InspectionStage::kViewRegistered, views[k].name, out.merged.points_per_view[k]);
+  if (IsCancelled(cancel)) return absl::CancelledError("inspect cancelled");
+  auto map =
+      ComputeErrorMap(part, out.merged.cloud_in_world, world_from_part, settings.error_map, cancel);
+  if (!map.ok()) return map.status();
+  out.error_map = *std::move(map);
+  if (progress) progress(InspectionStage::kErrorMap, "", out.error_map.stats.matched);
+  return out;
+}
+
+std::string ErrorMapReportText(const ErrorMapResult& result, const ErrorMapSettings& settings) {
+  return ErrorMapReportJson(result, settings).dump(2) + "\n";
+}
+
+absl::StatusOr<std::string> ErrorMapPngBytes(const PointCloud& cloud_in_world,
+                                             const Eigen::Isometry3d& world_from_part,
+                                             const ErrorMapResult& result,
+                                             const TriangleMesh& part_in_part) {
+  const PointCloud in_part = TransformCloud(cloud_in_world, world_from_part.inverse());
+  auto image = RenderErrorMap(in_part, result, ComputeBounds(part_in_part));
+  if (!image.ok()) return image.status();
+  return EncodePng(*image);
+}
+
+}  // namespace surfinspect

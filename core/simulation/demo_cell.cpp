@@ -1,0 +1,283 @@
+#include "core/simulation/demo_cell.h"
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <random>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "core/io/atomic_file.h"
+#include "core/io/io_mesh.h"
+#include "core/io/io_point_cloud.h"
+#include "core/io/io_transform.h"
+#include "core/types/transform.h"
+
+namespace surfinspect {
+namespace {
+
+using Vec2 = Eigen::Vector2d;  // (y, z) in the pillar's cross-section
+
+// Pillar cross-section: a hat channel. Top ridge half-width, height, wall
+// angle, flange width and bend radius, all mm; the numbers are those of a
+// typical stamped B-pillar reinforcement.
+constexpr double kTopHalfWidth = 30, kHeight = 60, kWallDeg = 75, kFlange = 30, kBendRadius = 6;
+constexpr int kBendSegments = 8;
+constexpr double kStepAlongMm = 5;  // extrusion step
+constexpr double kBowSagMm = 3;     // the ridge sags 3 mm towards the ends
+
+// Rounds the corners of a polyline with circular arcs of radius r.
+std::vector<Vec2> FilletPolyline(const std::vector<Vec2>& sharp, double r, int segments) {
+  std::vector<Vec2> out{sharp.front()};
+  for (std::size_t i = 1; i + 1 < sharp.size(); ++i) {
+    const Vec2 c = sharp[i];
+    const Vec2 u1 = (c - sharp[i - 1]).normalized(), u2 = (sharp[i + 1] - c).normalized();
+    const double cross = u1.x() * u2.y() - u1.y() * u2.x();
+    const double theta = std::acos(std::clamp(u1.dot(u2), -1.0, 1.0));  // turning angle
+    const double d = r * std::tan(theta / 2);
+    const Vec2 start = c - d * u1;
+    const Vec2 left(-u1.y(), u1.x());
+    const Vec2 centre = start + (cross > 0 ? r : -r) * left;
+    const double signed_theta = cross > 0 ? theta : -theta;
+    for (int k = 0; k <= segments; ++k) {
+      const double a = signed_theta * k / segments;
+      const Vec2 v = start - centre;
+      out.push_back(centre + Vec2(std::cos(a) * v.x() - std::sin(a) * v.y(),
+                                  std::sin(a) * v.x() + std::cos(a) * v.y()));
+    }
+  }
+  out.push_back(sharp.back());
+  return out;
+}
+
+void AddBox(TriangleMesh& m, const Eigen::Vector3f& lo, const Eigen::Vector3f& hi) {
+  const auto base = static_cast<uint32_t>(m.vertices.size());
+  for (int i = 0; i < 8; ++i)
+    m.vertices.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(),
+                            i & 4 ? hi.z() : lo.z());
+  const Triangle faces[12] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                              {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  for (const auto& f : faces) m.triangles.push_back({base + f[0], base + f[1], base + f[2]});
+}
+
+void AddSphere(TriangleMesh& m, const Eigen::Vector3d& c, double r, int slices, int stacks) {
+  const auto base = static_cast<uint32_t>(m.vertices.size());
+  m.vertices.push_back((c + Eigen::Vector3d(0, 0, r)).cast<float>());  // north pole
+  for (int s = 1; s < stacks; ++s) {
+    const double phi = M_PI * s / stacks;
+    for (int k = 0; k < slices; ++k) {
+      const double th = 2 * M_PI * k / slices;
+      m.vertices.push_back((c + r * Eigen::Vector3d(std::sin(phi) * std::cos(th),
+                                                    std::sin(phi) * std::sin(th), std::cos(phi)))
+                               .cast<float>());
+    }
+  }
+  m.vertices.push_back((c - Eigen::Vector3d(0, 0, r)).cast<float>());  // south pole
+  const uint32_t south = static_cast<uint32_t>(m.vertices.size() - 1);
+  auto ring = [&](int s, int k) { return base + 1 + uint32_t((s - 1) * slices + (k % slices)); };
+  for (int k = 0; k < slices; ++k) m.triangles.push_back({base, ring(1, k), ring(1, k + 1)});
+  for (int s = 1; s + 1 < stacks; ++s)
+    for (int k = 0; k < slices; ++k) {
+      m.triangles.push_back({ring(s, k), ring(s + 1, k), ring(s + 1, k + 1)});
+      m.triangles.push_back({ring(s, k), ring(s + 1, k + 1), ring(s, k + 1)});
+    }
+  for (int k = 0; k < slices; ++k)
+    m.triangles.push_back({south, ring(stacks - 1, k + 1), ring(stacks - 1, k)});
+}
+
+Eigen::Isometry3d Pose(const Eigen::Vector3d& t, double yaw_deg) {
+  Eigen::Isometry3d p = Eigen::Isometry3d::Identity();
+  p.linear() = Eigen::AngleAxisd(yaw_deg * M_PI / 180, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  p.translation() = t;
+  return p;
+}
+
+// A small rigid perturbation of exactly `mm` and `deg` in random directions.
+Eigen::Isometry3d Perturb(std::mt19937_64& rng, double mm, double deg) {
+  std::normal_distribution<double> g;
+  const Eigen::Vector3d axis = Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized();
+  const Eigen::Vector3d dir = Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized();
+  Eigen::Isometry3d d = Eigen::Isometry3d::Identity();
+  d.linear() = Eigen::AngleAxisd(deg * M_PI / 180, axis).toRotationMatrix();
+  d.translation() = mm * dir;
+  return d;
+}
+
+double RidgeZ(double x, double length) {
+  const double u = x / (0.5 * length);
+  return kHeight - kBowSagMm * u * u;
+}
+
+}  // namespace
+
+TriangleMesh MakePillarMesh(double length_mm) {
+  const double run = kHeight / std::tan(kWallDeg * M_PI / 180);
+  const double a = kTopHalfWidth;
+  const std::vector<Vec2> sharp = {
+      {-(a + run + kFlange), 0}, {-(a + run), 0}, {-a, kHeight}, {a, kHeight}, {a + run, 0},
+      {a + run + kFlange, 0}};
+  const std::vector<Vec2> profile = FilletPolyline(sharp, kBendRadius, kBendSegments);
+  const int along = std::max(1, static_cast<int>(std::lround(length_mm / kStepAlongMm)));
+  const auto np = static_cast<uint32_t>(profile.size());
+  TriangleMesh m;
+  for (int j = 0; j <= along; ++j) {
+    const double x = -0.5 * length_mm + length_mm * j / along;
+    const double sag = kHeight - RidgeZ(x, length_mm);
+    for (const Vec2& p : profile) m.vertices.emplace_back(x, p.x(), p.y() - sag);
+  }
+  // (x step) x (profile tangent) points out of the material: +z on the ridge.
+  for (uint32_t j = 0; j < static_cast<uint32_t>(along); ++j)
+    for (uint32_t i = 0; i + 1 < np; ++i) {
+      const uint32_t v00 = j * np + i, v01 = (j + 1) * np + i, v10 = j * np + i + 1,
+                     v11 = (j + 1) * np + i + 1;
+      m.triangles.push_back({v00, v01, v10});
+      m.triangles.push_back({v10, v01, v11});
+    }
+  return m;
+}
+
+TriangleMesh MakeGaugeMesh() {
+  // Stepped plate (x-normal step faces) and three spheres of different radii
+  // at asymmetric spots: together they pin all six degrees of freedom.
+  TriangleMesh m;
+  AddBox(m, {-80, -60, -10}, {80, 60, 0});
+  AddBox(m, {10, -55, 0}, {75, 55, 15});  // inset: no edge shared with the plate
+  AddSphere(m, {-45, -25, 12}, 12, 48, 24);
+  AddSphere(m, {-30, 30, 18}, 18, 48, 24);
+  AddSphere(m, {45, 5, 15 + 20}, 20, 48, 24);
+  return m;
+}
+
+DemoCell MakeDemoCell(const DemoCellOptions& o) {
+  DemoCell cell;
+  cell.part = MakePillarMesh(o.part_length_mm);
+  cell.gauge = MakeGaugeMesh();
+  cell.world_from_part = Pose({600, 100, 5}, 3.0);
+  std::mt19937_64 rng(o.seed);
+  const double xs[5] = {-0.4, -0.2, 0.0, 0.2, 0.4};
+  const double tilt_deg[5][2] = {{12, -8}, {-10, 5}, {6, 10}, {-12, -6}, {10, 8}};
+  for (int v = 0; v < 5; ++v) {
+    const double x = xs[v] * o.part_length_mm;
+    const Eigen::Vector3d target_part(x, 0, RidgeZ(x, o.part_length_mm));
+    const Eigen::Vector3d target = cell.world_from_part * target_part;
+    const Eigen::Vector3d dir =
+        (Eigen::AngleAxisd(tilt_deg[v][0] * M_PI / 180, Eigen::Vector3d::UnitX()) *
+         Eigen::AngleAxisd(tilt_deg[v][1] * M_PI / 180, Eigen::Vector3d::UnitY()) *
+         Eigen::Vector3d::UnitZ());
+    DemoViewpoint vp;
+    vp.name = absl::StrCat("v", v + 1);
+    vp.world_from_sensor = LookAt(target + 400.0 * dir, target,
+                                  cell.world_from_part.linear() * -Eigen::Vector3d::UnitY());
+    vp.nominal_world_from_sensor =
+        vp.world_from_sensor * Perturb(rng, o.nominal_error_mm, o.nominal_error_deg);
+    // The gauge is surveyed where the optical axis meets z = 20 mm.
+    const Eigen::Vector3d eye = vp.world_from_sensor.translation();
+    const Eigen::Vector3d axis = vp.world_from_sensor.linear().col(2);
+    const double s = (20.0 - eye.z()) / axis.z();
+    const Eigen::Vector3d on_table = eye + s * axis;
+    vp.world_from_gauge = Pose({on_table.x(), on_table.y(), 0.0}, 15.0 * v - 20.0);
+    cell.viewpoints.push_back(vp);
+  }
+  return cell;
+}
+
+absl::Status WriteDemoCell(const std::string& dir, const DemoCell& cell,
+                           const DemoWriteOptions& options) {
+  std::error_code ec;
+  for (const char* sub : {"", "/gauge_scans", "/scans", "/truth"})
+    if (std::filesystem::create_directories(dir + sub, ec); ec)
+      return absl::PermissionDeniedError(absl::StrCat(dir, sub, ": ", ec.message()));
+  if (auto st = WriteMesh(dir + "/part.stl", cell.part); !st.ok()) return st;
+  if (auto st = WriteMesh(dir + "/gauge.stl", cell.gauge); !st.ok()) return st;
+
+  nlohmann::json views = nlohmann::json::array();
+  for (std::size_t v = 0; v < cell.viewpoints.size(); ++v) {
+    const DemoViewpoint& vp = cell.viewpoints[v];
+    ScanOptions gauge_opt = options.scan;
+    gauge_opt.defects.clear();
+    gauge_opt.seed = options.scan.seed * 1000 + v;
+    auto gauge_scan = SimulateScan(cell.gauge, vp.world_from_gauge, vp.world_from_sensor,
+                                   cell.intrinsics, gauge_opt);
+    if (!gauge_scan.ok()) return gauge_scan.status();
+    const std::string gauge_path = absl::StrCat("gauge_scans/", vp.name, ".pcd");
+    if (auto st = WritePointCloud(dir + "/" + gauge_path, gauge_scan->cloud_in_sensor); !st.ok())
+      return st;
+    views.push_back(
+        {{"name", vp.name},
+         {"nominal_world_from_sensor", TransformToJsonValue(vp.nominal_world_from_sensor)},
+         {"world_from_gauge", TransformToJsonValue(vp.world_from_gauge)},
+         {"gauge_scan", gauge_path},
+         {"simulation_truth_world_from_sensor", TransformToJsonValue(vp.world_from_sensor)}});
+  }
+
+  std::mt19937_64 rng(options.scan.seed + 7);
+  std::uniform_real_distribution<double> ux(-0.45, 0.45), uy(-18, 18), udepth(0.05, 0.5),
+      uradius(3, 8);
+  const double length = ComputeBounds(cell.part).max.x() - ComputeBounds(cell.part).min.x();
+  nlohmann::json parts = nlohmann::json::array();
+  for (int k = 1; k <= options.parts; ++k) {
+    const std::string part_id = absl::StrFormat("part-%03d", k);
+    ScanOptions opt = options.scan;
+    nlohmann::json defects = nlohmann::json::array();
+    for (int d = 0; d < 3; ++d) {
+      SurfaceDefect defect;
+      const double x = ux(rng) * length;
+      defect.center_in_part = {x, uy(rng), RidgeZ(x, length)};
+      defect.radius_mm = uradius(rng);
+      defect.depth_mm = (d == 2 ? -1 : 1) * udepth(rng);  // two dents and a bump
+      opt.defects.push_back(defect);
+      defects.push_back(
+          {{"center_in_part", {x, defect.center_in_part.y(), defect.center_in_part.z()}},
+           {"radius_mm", defect.radius_mm},
+           {"depth_mm", defect.depth_mm}});
+    }
+    std::filesystem::create_directories(absl::StrCat(dir, "/scans/", part_id), ec);
+    std::filesystem::create_directories(absl::StrCat(dir, "/truth/", part_id), ec);
+    nlohmann::json scans = nlohmann::json::object();
+    for (std::size_t v = 0; v < cell.viewpoints.size(); ++v) {
+      const DemoViewpoint& vp = cell.viewpoints[v];
+      opt.seed = options.scan.seed * 7919 + k * 100 + v;
+      auto scan =
+          SimulateScan(cell.part, cell.world_from_part, vp.world_from_sensor, cell.intrinsics, opt);
+      if (!scan.ok()) return scan.status();
+      const std::string path = absl::StrCat(dir, "/scans/", part_id, "/", vp.name, ".pcd");
+      if (auto st = WritePointCloud(path, scan->cloud_in_sensor); !st.ok()) return st;
+      nlohmann::json pulses = nlohmann::json::array(), stripes = nlohmann::json::array();
+      for (std::size_t i = 0; i < scan->labels.size(); ++i) {
+        if (scan->labels[i] == PixelLabel::kPulse) pulses.push_back(i);
+        if (scan->labels[i] == PixelLabel::kStripe) stripes.push_back(i);
+      }
+      const nlohmann::json truth = {
+          {"part_id", part_id},         {"viewpoint", vp.name},
+          {"valid_points", scan->hits}, {"pulse_pixels", pulses},
+          {"stripe_pixels", stripes},   {"defect_pixels", scan->defect_pixels}};
+      if (auto st = WriteStringAtomically(
+              absl::StrCat(dir, "/truth/", part_id, "/", vp.name, ".json"), truth.dump());
+          !st.ok())
+        return st;
+      scans[vp.name] = absl::StrCat("scans/", part_id, "/", vp.name, ".pcd");
+    }
+    parts.push_back({{"part_id", part_id}, {"defects", defects}, {"scans", scans}});
+  }
+
+  const nlohmann::json cell_json = {
+      {"units", "mm"},
+      {"part",
+       {{"mesh", "part.stl"}, {"world_from_part", TransformToJsonValue(cell.world_from_part)}}},
+      {"gauge", {{"mesh", "gauge.stl"}}},
+      {"sensor",
+       {{"width", cell.intrinsics.width},
+        {"height", cell.intrinsics.height},
+        {"horizontal_fov_deg", cell.intrinsics.horizontal_fov_deg},
+        {"min_range_mm", cell.intrinsics.min_range_mm},
+        {"max_range_mm", cell.intrinsics.max_range_mm}}},
+      {"viewpoints", views},
+      // Stamped sheet metal: +-0.3 mm, and 0.1% of the points may fall
+      // outside (unfiltered speckle at shadow edges) before a part fails.
+      {"tolerance_mm", 0.3},
+      {"error_map", {{"allowed_fraction_outside", 0.001}, {"max_distance_mm", 5.0}}}};
+  if (auto st = WriteStringAtomically(dir + "/cell.json", cell_json.dump(2) + "\n"); !st.ok())
+    return st;
+  return WriteStringAtomically(dir + "/truth/parts.json", nlohmann::json(parts).dump(2) + "\n");
+}
+
+}  // namespace surfinspect

@@ -1,0 +1,102 @@
+#include "core/filter/link_row_masks.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "core/filter/link_clustering.h"
+
+namespace surfinspect::link_row {
+namespace {
+
+bool Bit(const std::vector<uint64_t>& bits, uint32_t i) { return (bits[i / 64] >> (i % 64)) & 1; }
+
+// Rows of random width with NaN holes, 3/8 mm pitch and heights on a 1/8 mm
+// lattice, so a height step of 4/8 puts a pair at exactly d = 5/8 mm (all
+// exact in float): every mask bit must equal the scalar PointsLinked,
+// ties included (the SIMD path may not round or compare differently).
+TEST(LinkRowMasks, EveryBitEqualsThePointsLinkedPredicate) {
+  std::mt19937 rng(4);
+  std::uniform_int_distribution<uint32_t> width(1, 200);
+  std::uniform_int_distribution<int> lattice(-5, 5);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  const float d = 0.625f, r2 = LinkDistanceSquared(d);
+  ASSERT_TRUE(PointsLinked({0, 0, 0}, {0.375f, 0, 0.5f}, r2));  // the tie links
+  int ties = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const uint32_t w = width(rng), words = (w + 63) / 64;
+    std::vector<Eigen::Vector3f> up_pts(w), cur_pts(w);
+    for (auto* row : {&up_pts, &cur_pts})
+      for (uint32_t c = 0; c < w; ++c)
+        (*row)[c] = u(rng) < 0.1f ? Eigen::Vector3f(NAN, 0.f, 0.f)
+                                  : Eigen::Vector3f(0.375f * c, (row == &up_pts ? 0.f : 0.375f),
+                                                    0.125f * lattice(rng));
+    RowSoA up(64 * words), cur(64 * words);
+    Transpose(up_pts.data(), w, up);
+    Transpose(cur_pts.data(), w, cur);
+    for (uint32_t c = 0; c < w; ++c)
+      for (int a = 0; a < 3; ++a) {
+        ASSERT_EQ(std::isnan(cur.c(a)[c]), std::isnan(cur_pts[c][a]));
+        if (!std::isnan(cur_pts[c][a])) {
+          ASSERT_EQ(cur.c(a)[c], cur_pts[c][a]);
+        }
+      }
+    std::vector<uint64_t> storage(5 * words, ~uint64_t{0});
+    const RowMasks m = {&storage[0], &storage[words], &storage[2 * words], &storage[3 * words],
+                        &storage[4 * words]};
+    const bool diagonals = trial % 2 == 0;
+    ASSERT_FALSE(ComputeMasks(cur, &up, diagonals, words, r2, m));
+    auto bits = [&](const uint64_t* p) { return std::vector<uint64_t>(p, p + words); };
+    const auto valid = bits(m.valid), west = bits(m.west), nw = bits(m.north_west),
+               n = bits(m.north), ne = bits(m.north_east);
+    for (uint32_t c = 0; c < 64 * words; ++c) {
+      if (c >= w) {  // padding: no data, no links
+        ASSERT_FALSE(Bit(valid, c) || Bit(west, c) || Bit(n, c) || Bit(nw, c) || Bit(ne, c));
+        continue;
+      }
+      const Eigen::Vector3f& p = cur_pts[c];
+      ASSERT_EQ(Bit(valid, c), PointCloud::IsValid(p)) << c;
+      ASSERT_EQ(Bit(west, c), c > 0 && PointsLinked(p, cur_pts[c - 1], r2)) << c;
+      ties += c > 0 && (p - cur_pts[c - 1]).squaredNorm() == r2;
+      ASSERT_EQ(Bit(n, c), PointsLinked(p, up_pts[c], r2)) << c;
+      ASSERT_EQ(Bit(nw, c), diagonals && c > 0 && PointsLinked(p, up_pts[c - 1], r2)) << c;
+      ASSERT_EQ(Bit(ne, c), diagonals && c + 1 < w && PointsLinked(p, up_pts[c + 1], r2)) << c;
+    }
+    // Bounds over any all-valid span equal the scalar min / max.
+    for (uint32_t first = 0; first < w; first += 7) {
+      uint32_t last = first;
+      while (last + 1 < w && PointCloud::IsValid(cur_pts[last + 1]) && last - first < 40) ++last;
+      if (!PointCloud::IsValid(cur_pts[first])) continue;
+      float lo[3], hi[3];
+      Bounds(cur, first, last, lo, hi);
+      Eigen::Vector3f want_lo = cur_pts[first], want_hi = cur_pts[first];
+      for (uint32_t c = first; c <= last; ++c) {
+        want_lo = want_lo.cwiseMin(cur_pts[c]);
+        want_hi = want_hi.cwiseMax(cur_pts[c]);
+      }
+      for (int a = 0; a < 3; ++a) {
+        ASSERT_EQ(lo[a], want_lo[a]);
+        ASSERT_EQ(hi[a], want_hi[a]);
+      }
+    }
+  }
+  EXPECT_GT(ties, 100);
+}
+
+TEST(LinkRowMasks, FirstRowHasNoVerticalLinksAndInfinityIsReported) {
+  std::vector<Eigen::Vector3f> pts(70, Eigen::Vector3f(0.f, 0.f, 1.f));
+  RowSoA row(128);
+  Transpose(pts.data(), 70, row);
+  std::vector<uint64_t> storage(10, ~uint64_t{0});
+  const RowMasks m = {&storage[0], &storage[2], &storage[4], &storage[6], &storage[8]};
+  EXPECT_FALSE(ComputeMasks(row, nullptr, true, 2, 0.25f, m));
+  EXPECT_EQ(storage[6] | storage[7] | storage[4] | storage[5] | storage[8] | storage[9], 0u);
+  EXPECT_EQ(storage[0], ~uint64_t{0});
+  EXPECT_EQ(storage[1], (uint64_t{1} << 6) - 1);
+  pts[69] = {0.f, -INFINITY, NAN};
+  Transpose(pts.data(), 70, row);
+  EXPECT_TRUE(ComputeMasks(row, nullptr, true, 2, 0.25f, m));
+}
+
+}  // namespace
+}  // namespace surfinspect::link_row

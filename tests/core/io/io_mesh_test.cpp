@@ -1,0 +1,142 @@
+#include "core/io/io_mesh.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include "tests/support/temp_dir.h"
+
+namespace surfinspect {
+namespace {
+
+using testing::TempDir;
+using testing::WriteBytes;
+
+// Unit cube [0,10]^3 with outward CCW triangles.
+TriangleMesh Cube() {
+  TriangleMesh m;
+  for (int i = 0; i < 8; ++i)
+    m.vertices.emplace_back(10.f * (i & 1), 10.f * ((i >> 1) & 1), 10.f * ((i >> 2) & 1));
+  m.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                 {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  return m;
+}
+
+// Signed volume by the divergence theorem: positive when normals face out.
+double SignedVolume(const TriangleMesh& m) {
+  double v = 0;
+  for (const auto& t : m.triangles)
+    v += m.vertices[t[0]].cast<double>().dot(
+             m.vertices[t[1]].cast<double>().cross(m.vertices[t[2]].cast<double>())) /
+         6.0;
+  return v;
+}
+
+TEST(TriangleMesh, CubeIsClosedWithOutwardNormals) {
+  const TriangleMesh cube = Cube();
+  EXPECT_TRUE(AnalyzeTopology(cube).closed());
+  EXPECT_NEAR(SignedVolume(cube), 1000.0, 1e-9);
+  const auto n = cube.FaceNormals();
+  EXPECT_TRUE(n[0].isApprox(Eigen::Vector3f(0, 0, -1)));
+  EXPECT_TRUE(n[2].isApprox(Eigen::Vector3f(0, 0, 1)));
+}
+
+class MeshRoundTrip : public ::testing::TestWithParam<std::pair<MeshFormat, const char*>> {};
+
+TEST_P(MeshRoundTrip, KeepsShapeTopologyAndWinding) {
+  TempDir dir;
+  const std::string path = dir.File(GetParam().second);
+  ASSERT_TRUE(WriteMesh(path, Cube(), GetParam().first).ok());
+  auto back = ReadMesh(path);
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(back->num_triangles(), 12u);
+  EXPECT_EQ(back->vertices.size(), 8u) << "identical vertices merged";
+  EXPECT_TRUE(AnalyzeTopology(*back).closed());
+  EXPECT_NEAR(SignedVolume(*back), 1000.0, 1e-6);
+}
+
+INSTANTIATE_TEST_SUITE_P(Formats, MeshRoundTrip,
+                         ::testing::Values(std::make_pair(MeshFormat::kStlBinary, "cube.stl"),
+                                           std::make_pair(MeshFormat::kStlAscii, "cube_ascii.stl"),
+                                           std::make_pair(MeshFormat::kObj, "cube.obj"),
+                                           std::make_pair(MeshFormat::kPlyBinary, "cube.ply"),
+                                           std::make_pair(MeshFormat::kPlyAscii,
+                                                          "cube_ascii.ply")));
+
+TEST(ReadMesh, Off) {
+  TempDir dir;
+  WriteBytes(dir.File("t.off"), "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n");
+  auto m = ReadMesh(dir.File("t.off"));
+  ASSERT_TRUE(m.ok()) << m.status();
+  EXPECT_EQ(m->num_triangles(), 2u);
+  EXPECT_EQ(AnalyzeTopology(*m).boundary_edges, 4u);
+}
+
+TEST(ReadMesh, KeepsSomeDegenerateTriangles) {
+  TempDir dir;
+  WriteBytes(dir.File("d.off"), "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n2 0 0\n3 0 1 2\n3 0 1 3\n");
+  auto m = ReadMesh(dir.File("d.off"));
+  ASSERT_TRUE(m.ok()) << m.status();
+  EXPECT_EQ(m->CountDegenerate(), 1u);
+}
+
+struct BadMesh {
+  const char* name;
+  const char* file;
+  std::string bytes;
+  const char* message_part;
+};
+
+std::string BinaryStlHeader(uint32_t declared) {
+  std::string s(80, ' ');
+  s.append(reinterpret_cast<const char*>(&declared), 4);
+  return s;
+}
+
+class MalformedMesh : public ::testing::TestWithParam<BadMesh> {};
+
+TEST_P(MalformedMesh, GivesClearError) {
+  TempDir dir;
+  const std::string path = dir.File(GetParam().file);
+  WriteBytes(path, GetParam().bytes);
+  auto m = ReadMesh(path);
+  ASSERT_FALSE(m.ok());
+  EXPECT_NE(m.status().message().find(GetParam().message_part), std::string::npos) << m.status();
+  EXPECT_NE(m.status().message().find(path), std::string::npos) << "names the file";
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Files, MalformedMesh,
+    ::testing::Values(
+        BadMesh{"empty", "e.stl", "", "empty"},
+        BadMesh{"truncated_binary_stl", "t.stl", BinaryStlHeader(1000) + std::string(100, 'x'),
+                "cannot import"},
+        BadMesh{"nan_vertex", "n.off", "OFF\n3 1 0\n0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n",
+                "not finite"},
+        BadMesh{"only_degenerate", "d.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n2 0 0\n3 0 1 2\n",
+                "degenerate"},
+        BadMesh{"index_out_of_range", "i.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n",
+                "cannot import"},
+        BadMesh{"points_only", "p.ply",
+                "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+                "property float z\nend_header\n0 0 0\n1 1 1\n",
+                "cannot import"},
+        BadMesh{"garbage", "g.stl", std::string("solid x\nfacet normal oops\n"), "cannot import"}),
+    [](const auto& info) { return std::string(info.param.name); });
+
+TEST(ReadMesh, MissingFileIsNotFound) {
+  auto m = ReadMesh("/nonexistent/part.stl");
+  ASSERT_FALSE(m.ok());
+  EXPECT_EQ(m.status().code(), absl::StatusCode::kNotFound);
+}
+
+TEST(WriteMesh, RefusesInvalidMesh) {
+  TempDir dir;
+  TriangleMesh bad = Cube();
+  bad.triangles.push_back({0, 1, 99});
+  EXPECT_FALSE(WriteMesh(dir.File("bad.stl"), bad).ok());
+  EXPECT_TRUE(testing::ReadBytes(dir.File("bad.stl")).empty());
+}
+
+}  // namespace
+}  // namespace surfinspect
