@@ -15,8 +15,8 @@
 #include <map>
 #include <random>
 
-#include "core/errormap/error_map.h"
 #include "core/distance/mesh_index.h"
+#include "core/errormap/error_map.h"
 
 #ifdef SURFINSPECT_HAVE_OPEN3D
 #include <open3d/core/Tensor.h>

@@ -24,10 +24,10 @@
 #include <map>
 #include <random>
 
-#include "core/simulation/demo_cell.h"
 #include "core/filter/link_clustering.h"
 #include "core/filter/link_clustering_grid.h"
 #include "core/filter/link_clustering_unorganized.h"
+#include "core/simulation/demo_cell.h"
 #include "core/simulation/scan_simulator.h"
 
 namespace {

@@ -9,9 +9,9 @@
 #include <string>
 
 #include "absl/status/statusor.h"
-#include "core/registration/calibration.h"
 #include "core/errormap/error_map.h"
 #include "core/filter/link_clustering.h"
+#include "core/registration/calibration.h"
 #include "core/types/point_cloud.h"
 #include "core/types/triangle_mesh.h"
 #include "surfinspect/v1/inspection.pb.h"

@@ -8,10 +8,10 @@
 #include <nlohmann/json.hpp>
 
 #include "absl/strings/str_cat.h"
-#include "core/registration/calibration.h"
-#include "core/pipeline/inspection.h"
 #include "core/filter/link_clustering.h"
 #include "core/io/mesh_hash.h"
+#include "core/pipeline/inspection.h"
+#include "core/registration/calibration.h"
 #include "core/registration/registration.h"
 #include "core/types/transform.h"
 #include "server/cancel_signal.h"

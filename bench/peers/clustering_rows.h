@@ -22,10 +22,10 @@
 #include <random>
 
 #include "bench/peers/report.h"
-#include "core/simulation/demo_cell.h"
 #include "core/filter/link_clustering.h"
 #include "core/filter/link_clustering_grid.h"
 #include "core/filter/link_clustering_unorganized.h"
+#include "core/simulation/demo_cell.h"
 #include "core/simulation/scan_simulator.h"
 
 namespace surfinspect::bench {

@@ -25,10 +25,10 @@
 #include "client/cell/part_outputs.h"
 #include "client/remote/remote_client.h"
 #include "core/io/atomic_file.h"
-#include "core/process/buffer_reuse.h"
-#include "core/process/quiet_consoles.h"
 #include "core/io/io_mesh.h"
 #include "core/io/io_point_cloud.h"
+#include "core/process/buffer_reuse.h"
+#include "core/process/quiet_consoles.h"
 #include "proto/convert.h"
 
 namespace surfinspect::client {

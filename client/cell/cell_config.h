@@ -20,8 +20,8 @@
 
 #include "absl/status/statusor.h"
 #include "core/errormap/error_map.h"
-#include "core/pipeline/inspection.h"
 #include "core/filter/link_clustering.h"
+#include "core/pipeline/inspection.h"
 
 namespace surfinspect::client {
 

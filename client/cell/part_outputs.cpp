@@ -4,8 +4,8 @@
 #include <nlohmann/json.hpp>
 
 #include "absl/strings/str_cat.h"
-#include "core/io/atomic_file.h"
 #include "core/errormap/error_map_output.h"
+#include "core/io/atomic_file.h"
 #include "proto/convert.h"
 
 namespace surfinspect::client {

@@ -8,10 +8,10 @@
 #include "client/cli/commands.h"
 #include "client/cli/remote_args.h"
 #include "core/io/atomic_file.h"
-#include "core/registration/calibration.h"
 #include "core/io/io_mesh.h"
 #include "core/io/io_point_cloud.h"
 #include "core/io/io_transform.h"
+#include "core/registration/calibration.h"
 #include "proto/convert.h"
 
 namespace surfinspect::cli {

@@ -9,14 +9,14 @@
 
 #include "client/cli/commands.h"
 #include "client/cli/remote_args.h"
-#include "core/io/atomic_file.h"
+#include "core/distance/mesh_index.h"
 #include "core/errormap/error_map.h"
 #include "core/errormap/error_map_output.h"
 #include "core/errormap/error_map_png.h"
+#include "core/io/atomic_file.h"
 #include "core/io/io_mesh.h"
 #include "core/io/io_point_cloud.h"
 #include "core/io/io_transform.h"
-#include "core/distance/mesh_index.h"
 #include "core/types/transform.h"
 #include "proto/convert.h"
 

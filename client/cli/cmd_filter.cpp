@@ -9,9 +9,9 @@
 
 #include "client/cli/commands.h"
 #include "client/cli/remote_args.h"
+#include "core/filter/link_clustering.h"
 #include "core/io/atomic_file.h"
 #include "core/io/io_point_cloud.h"
-#include "core/filter/link_clustering.h"
 #include "core/io/png_image.h"
 #include "proto/convert.h"
 

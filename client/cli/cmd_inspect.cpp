@@ -9,9 +9,9 @@
 #include "client/cell/part_outputs.h"
 #include "client/cli/commands.h"
 #include "client/cli/remote_args.h"
-#include "core/pipeline/inspection.h"
 #include "core/io/io_mesh.h"
 #include "core/io/io_point_cloud.h"
+#include "core/pipeline/inspection.h"
 #include "proto/convert.h"
 
 namespace surfinspect::cli {

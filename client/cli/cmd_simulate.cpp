@@ -9,10 +9,10 @@
 #include "absl/strings/str_split.h"
 #include "client/cli/commands.h"
 #include "core/io/atomic_file.h"
-#include "core/simulation/demo_cell.h"
 #include "core/io/io_mesh.h"
 #include "core/io/io_point_cloud.h"
 #include "core/io/io_transform.h"
+#include "core/simulation/demo_cell.h"
 
 namespace surfinspect::cli {
 namespace {

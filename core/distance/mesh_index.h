@@ -32,8 +32,8 @@
 
 #include "absl/functional/function_ref.h"
 #include "absl/status/statusor.h"
-#include "core/types/point_cloud.h"
 #include "core/distance/point_triangle.h"
+#include "core/types/point_cloud.h"
 #include "core/types/triangle_mesh.h"
 
 namespace surfinspect {

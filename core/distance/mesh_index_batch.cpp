@@ -18,8 +18,8 @@
 #include <new>
 
 #include "absl/strings/str_cat.h"
-#include "core/types/cancel.h"
 #include "core/distance/mesh_index.h"
+#include "core/types/cancel.h"
 
 namespace surfinspect {
 namespace {

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "core/types/cancel.h"
 #include "core/filter/link_row_masks.h"
+#include "core/types/cancel.h"
 
 namespace surfinspect {
 namespace {

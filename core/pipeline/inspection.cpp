@@ -3,9 +3,9 @@
 #include <nlohmann/json.hpp>
 
 #include "absl/strings/str_cat.h"
-#include "core/types/cancel.h"
 #include "core/errormap/error_map_output.h"
 #include "core/errormap/error_map_png.h"
+#include "core/types/cancel.h"
 #include "core/types/transform.h"
 
 namespace surfinspect {

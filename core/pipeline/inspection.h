@@ -12,9 +12,9 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "core/distance/mesh_index.h"
 #include "core/errormap/error_map.h"
 #include "core/filter/link_clustering.h"
-#include "core/distance/mesh_index.h"
 #include "core/registration/registration.h"
 
 namespace surfinspect {

@@ -16,9 +16,9 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/registration/icp.h"
-#include "core/filter/link_clustering.h"
 #include "core/distance/mesh_index.h"
+#include "core/filter/link_clustering.h"
+#include "core/registration/icp.h"
 
 namespace surfinspect {
 

@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/registration/icp.h"
 #include "core/distance/mesh_index.h"
+#include "core/registration/icp.h"
 #include "core/types/point_cloud.h"
 
 namespace surfinspect {

@@ -15,10 +15,10 @@
 #include <thread>
 
 #include "client/remote/remote_client.h"
+#include "core/io/mesh_hash.h"
+#include "core/pipeline/inspection.h"
 #include "core/registration/calibration.h"
 #include "core/simulation/demo_cell.h"
-#include "core/pipeline/inspection.h"
-#include "core/io/mesh_hash.h"
 #include "proto/convert.h"
 #include "tests/support/server_process.h"
 #include "tests/support/temp_dir.h"

@@ -10,9 +10,9 @@
 #include <random>
 #include <sstream>
 
-#include "core/simulation/demo_cell.h"
 #include "core/errormap/error_map_output.h"
 #include "core/errormap/error_map_png.h"
+#include "core/simulation/demo_cell.h"
 #include "core/simulation/scan_simulator.h"
 #include "core/types/transform.h"
 #include "tests/support/temp_dir.h"

@@ -6,8 +6,8 @@
 #include <cstring>
 #include <iostream>
 
-#include "core/simulation/demo_cell.h"
 #include "core/filter/link_clustering.h"
+#include "core/simulation/demo_cell.h"
 #include "core/simulation/scan_simulator.h"
 
 namespace surfinspect {
