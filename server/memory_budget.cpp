@@ -1,0 +1,113 @@
+#include "server/memory_budget.h"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <fstream>
+#include <string>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+
+namespace surfinspect::server {
+namespace {
+
+constexpr double kMiB = 1024.0 * 1024.0;
+
+// A cgroup file holding a byte count, or "max"; 0 when absent or unlimited.
+uint64_t ReadCgroupBytes(const char* path) {
+  std::ifstream in(path);
+  std::string text;
+  if (!(in >> text)) return 0;
+  uint64_t bytes = 0;
+  if (!absl::SimpleAtoi(text, &bytes)) return 0;  // "max"
+  // cgroup v1 writes a page-rounded INT64_MAX for "no limit".
+  return bytes >= (uint64_t{1} << 60) ? 0 : bytes;
+}
+
+}  // namespace
+
+MemoryBudget::Reservation::Reservation(Reservation&& other) noexcept
+    : budget_(other.budget_), bytes_(other.bytes_) {
+  other.budget_ = nullptr;
+  other.bytes_ = 0;
+}
+
+MemoryBudget::Reservation& MemoryBudget::Reservation::operator=(Reservation&& other) noexcept {
+  if (this != &other) {
+    Release();
+    budget_ = other.budget_;
+    bytes_ = other.bytes_;
+    other.budget_ = nullptr;
+    other.bytes_ = 0;
+  }
+  return *this;
+}
+
+MemoryBudget::Reservation::~Reservation() { Release(); }
+
+void MemoryBudget::Reservation::Release() {
+  if (budget_ != nullptr) budget_->Return(bytes_);
+  budget_ = nullptr;
+  bytes_ = 0;
+}
+
+absl::StatusOr<MemoryBudget::Reservation> MemoryBudget::TryReserve(uint64_t bytes,
+                                                                   const std::string& what) {
+  if (bytes > budget_) {
+    refused_.fetch_add(bytes, std::memory_order_relaxed);
+    return absl::ResourceExhaustedError(absl::StrFormat(
+        "%s needs %.0f MiB, more than the server's whole memory budget of %.0f MiB; "
+        "send a smaller request or raise --max-memory-mb",
+        what, bytes / kMiB, budget_ / kMiB));
+  }
+  uint64_t held = reserved_.load(std::memory_order_relaxed);
+  do {
+    if (held + bytes > budget_) {
+      refused_.fetch_add(bytes, std::memory_order_relaxed);
+      return absl::ResourceExhaustedError(absl::StrFormat(
+          "%s needs %.0f MiB and %.0f MiB of the %.0f MiB memory budget are held by other "
+          "calls; retry later",
+          what, bytes / kMiB, held / kMiB, budget_ / kMiB));
+    }
+  } while (!reserved_.compare_exchange_weak(held, held + bytes, std::memory_order_relaxed));
+  return Reservation(this, bytes);
+}
+
+MemoryLimits DetectMemoryLimits() {
+  MemoryLimits m;
+  m.physical_bytes = uint64_t(sysconf(_SC_PHYS_PAGES)) * uint64_t(sysconf(_SC_PAGESIZE));
+  m.cgroup_bytes = ReadCgroupBytes("/sys/fs/cgroup/memory.max");
+  if (m.cgroup_bytes == 0)
+    m.cgroup_bytes = ReadCgroupBytes("/sys/fs/cgroup/memory/memory.limit_in_bytes");
+  rlimit as{};
+  if (getrlimit(RLIMIT_AS, &as) == 0 && as.rlim_cur != RLIM_INFINITY)
+    m.address_space_bytes = as.rlim_cur;
+  uint64_t base = m.physical_bytes;
+  m.source = "physical memory";
+  if (m.cgroup_bytes != 0 && m.cgroup_bytes < base) {
+    base = m.cgroup_bytes;
+    m.source = "cgroup";
+  }
+  m.default_budget_bytes = base / 4 * 3;
+  if (m.address_space_bytes != 0 && m.address_space_bytes / 2 < m.default_budget_bytes) {
+    m.default_budget_bytes = m.address_space_bytes / 2;
+    m.source = "address-space limit";
+  }
+  return m;
+}
+
+// An Inspect call holds, per point received: the view's cloud as it arrives
+// (12 B, float xyz), the filter's labels and kept mask (5 B), the kept
+// points in the world frame (12 B) with their view and pixel (8 B), the
+// error map's signed distance, triangle id and closest point (4 + 4 + 12 B),
+// and the response's packed copies (8 B). Rounded up for vector growth.
+uint64_t InspectBytesPerPoint() { return 80; }
+
+// A unary call's cloud is held twice (the protobuf bytes and the
+// PointCloud), plus the result arrays of the error map.
+uint64_t UnaryCloudBytesPerPoint() { return 64; }
+
+}  // namespace surfinspect::server
