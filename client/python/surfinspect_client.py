@@ -11,6 +11,7 @@ sensor coordinates into the world frame), as in cell.json.
 """
 import hashlib
 import json
+import math
 import os
 import struct
 
@@ -29,50 +30,84 @@ class ClientError(Exception):
 
 # ---- files ---------------------------------------------------------------
 
-def read_pcd(path):
-    """(xyz bytes as little-endian float32, width, height) of a PCD file.
+PCD_KEYS = ("VERSION", "FIELDS", "SIZE", "TYPE", "COUNT", "WIDTH", "HEIGHT", "VIEWPOINT", "POINTS",
+            "DATA")
+MAX_HEADER_BYTES = 64 << 10
 
-    Reads the ascii and binary encodings with x, y, z float32 fields among any
-    others; NaN marks a pixel with no data (organized grids are kept).
-    """
-    with open(path, "rb") as f:
-        data = f.read()
-    header, offset = {}, 0
-    while True:
+
+def _pcd_header(path, data):
+    """({KEY: [words]}, data offset), refusing what the C++ reader refuses:
+    an unknown or repeated key, a key out of order, a header over 64 KiB."""
+    header, offset, last = {}, 0, -1
+    while "DATA" not in header:
         end = data.find(b"\n", offset)
-        if end < 0:
-            raise ClientError(f"{path}: truncated PCD header")
+        if end < 0 or end > MAX_HEADER_BYTES:
+            raise ClientError(f"{path}: truncated PCD header (no DATA line in the first 64 KiB)")
         line = data[offset:end].decode("ascii", "replace").strip()
         offset = end + 1
         if not line or line.startswith("#"):
             continue
         key, _, value = line.partition(" ")
-        header[key.upper()] = value.split()
-        if key.upper() == "DATA":
-            break
+        key = key.upper()
+        if key not in PCD_KEYS:
+            raise ClientError(f"{path}: unknown PCD header line {line[:40]!r}")
+        if key in header or PCD_KEYS.index(key) < last:
+            raise ClientError(f"{path}: PCD header key {key} repeated or out of order")
+        last = PCD_KEYS.index(key)
+        header[key] = value.split()
+    return header, offset
+
+
+def _positive_int(path, header, key):
+    words = header.get(key)
+    if not words or len(words) != 1 or not words[0].isdigit() or int(words[0]) <= 0:
+        raise ClientError(f"{path}: PCD {key} must be one positive integer, not {words}")
+    return int(words[0])
+
+
+def read_pcd(path):
+    """(xyz bytes as little-endian float32, width, height) of a PCD file.
+
+    Reads the ascii and binary encodings with x, y, z float32 fields among any
+    others; NaN marks a pixel with no data (organized grids are kept). The
+    header is parsed strictly and every declared size is checked against the
+    file before anything is allocated from it.
+    """
+    with open(path, "rb") as f:
+        data = f.read()
+    header, offset = _pcd_header(path, data)
+    fields = header.get("FIELDS", [])
     try:
-        fields = header["FIELDS"]
-        sizes = [int(s) for s in header["SIZE"]]
+        sizes = [int(v) for v in header["SIZE"]]
         types = header["TYPE"]
         counts = [int(c) for c in header.get("COUNT", ["1"] * len(fields))]
-        width, height = int(header["WIDTH"][0]), int(header["HEIGHT"][0])
-        encoding = header["DATA"][0]
-    except (KeyError, ValueError, IndexError) as e:
+    except (KeyError, ValueError) as e:
         raise ClientError(f"{path}: malformed PCD header ({e})") from None
+    width, height = _positive_int(path, header, "WIDTH"), _positive_int(path, header, "HEIGHT")
     n = width * height
-    if not 0 < n <= MAX_POINTS or not len(fields) == len(sizes) == len(types) == len(counts):
+    if not n <= MAX_POINTS or not 0 < len(fields) == len(sizes) == len(types) == len(counts):
         raise ClientError(f"{path}: bad PCD sizes ({width} x {height}, {len(fields)} fields)")
+    if "POINTS" in header and _positive_int(path, header, "POINTS") != n:
+        raise ClientError(f"{path}: bad PCD sizes (POINTS is not WIDTH x HEIGHT = {n})")
+    if len(set(fields)) != len(fields) or any(s not in (1, 2, 4, 8) for s in sizes) or \
+            any(t not in ("I", "U", "F") for t in types) or any(not 0 < c <= 1 << 16 for c in counts):
+        raise ClientError(f"{path}: bad PCD fields (names, SIZE 1/2/4/8, TYPE I/U/F, COUNT)")
     for axis in "xyz":
         if axis not in fields:
             raise ClientError(f"{path}: no {axis} field")
         i = fields.index(axis)
         if (sizes[i], types[i], counts[i]) != (4, "F", 1):
             raise ClientError(f"{path}: field {axis} is not a float32")
+    encoding = header["DATA"][0] if len(header["DATA"]) == 1 else ""
     if encoding == "binary":
-        return _pcd_binary_xyz(path, data[offset:], fields, sizes, counts, n), width, height
-    if encoding == "ascii":
-        return _pcd_ascii_xyz(path, data[offset:], fields, counts, n), width, height
-    raise ClientError(f"{path}: PCD encoding {encoding!r} is not supported here (use ascii or binary)")
+        xyz = _pcd_binary_xyz(path, data[offset:], fields, sizes, counts, n)
+    elif encoding == "ascii":
+        xyz = _pcd_ascii_xyz(path, data[offset:], fields, counts, n)
+    else:
+        raise ClientError(f"{path}: PCD encoding {header['DATA']} is not supported here (use ascii or binary)")
+    if any(math.isinf(v) for v in struct.unpack(f"<{3 * n}f", xyz)):
+        raise ClientError(f"{path}: a point has an infinite coordinate (NaN marks no point)")
+    return xyz, width, height
 
 
 def _pcd_binary_xyz(path, body, fields, sizes, counts, n):
@@ -93,8 +128,10 @@ def _pcd_binary_xyz(path, body, fields, sizes, counts, n):
 
 def _pcd_ascii_xyz(path, body, fields, counts, n):
     columns = {f: sum(counts[:i]) for i, f in enumerate(fields)}
-    lines = body.decode("ascii", "replace").split("\n")
-    rows = [l for l in lines if l.strip()]
+    words = sum(counts)
+    if len(body) < 2 * words * n - 1:  # each value takes a digit and a separator at least
+        raise ClientError(f"{path}: truncated: {len(body)} data bytes cannot hold {n} points")
+    rows = [l for l in body.decode("ascii", "replace").split("\n") if l.strip()]
     if len(rows) < n:
         raise ClientError(f"{path}: truncated: {len(rows)} points, header declares {n}")
     out = bytearray()
@@ -102,10 +139,38 @@ def _pcd_ascii_xyz(path, body, fields, counts, n):
     for row in rows[:n]:
         v = row.split()
         try:
+            if len(v) != words:
+                raise ValueError
             out += pack(*(float(v[columns[a]]) for a in "xyz"))
-        except (ValueError, IndexError):
-            raise ClientError(f"{path}: bad point line {row!r}") from None
+        except (ValueError, OverflowError):
+            raise ClientError(f"{path}: bad point line {row[:80]!r} (expected {words} numbers)") from None
     return bytes(out)
+
+
+def _stl_ascii_corners(path, data):
+    """Corners of an ASCII STL, three per facet; a facet with another number
+    of vertices is refused (this reader does not triangulate)."""
+    corners, in_loop = [], None
+    for number, line in enumerate(data.decode("ascii", "replace").splitlines(), 1):
+        w = line.split()
+        if not w:
+            continue
+        if w[0] == "outer":
+            in_loop = 0
+        elif w[0] == "vertex":
+            if in_loop is None or len(w) != 4:
+                raise ClientError(f"{path}: line {number}: a vertex outside a facet's loop, or not x y z")
+            try:
+                c = struct.unpack("<3f", struct.pack("<3f", *map(float, w[1:])))
+            except (ValueError, OverflowError):
+                raise ClientError(f"{path}: line {number}: bad vertex {line.strip()[:60]!r}") from None
+            corners.append(c)  # rounded through float32, as the wire and the C++ reader are
+            in_loop += 1
+        elif w[0] == "endloop":
+            if in_loop != 3:
+                raise ClientError(f"{path}: line {number}: a facet with {in_loop} vertices (STL facets are triangles)")
+            in_loop = None
+    return corners
 
 
 def read_stl(path):
@@ -124,17 +189,13 @@ def read_stl(path):
             v = struct.unpack_from("<9f", data, 84 + 50 * t + 12)
             corners += [v[0:3], v[3:6], v[6:9]]
     elif data.lstrip().startswith(b"solid"):
-        for line in data.decode("ascii", "replace").splitlines():
-            w = line.split()
-            if len(w) == 4 and w[0] == "vertex":
-                # Round through float32: the wire and the C++ reader use it.
-                corners.append(struct.unpack("<3f", struct.pack("<3f", *map(float, w[1:]))))
-        if len(corners) % 3:
-            raise ClientError(f"{path}: ascii STL with a facet that is not a triangle")
+        corners = _stl_ascii_corners(path, data)
     else:
         raise ClientError(f"{path}: not an STL file (binary size mismatch, no 'solid')")
     if not corners:
         raise ClientError(f"{path}: no triangles")
+    if not all(math.isfinite(x) for c in corners for x in c):
+        raise ClientError(f"{path}: a vertex is not finite")
     index, vertices, triangles = {}, bytearray(), bytearray()
     for c in corners:
         key = struct.pack("<3f", *c)
@@ -183,6 +244,12 @@ def read_cell(path):
         }
     except (KeyError, TypeError) as e:
         raise ClientError(f"{path}: missing {e}") from None
+    for key in ("error_map", "filter"):
+        if not isinstance(cell[key], dict):
+            raise ClientError(f"{path}: {key} must be an object")
+    if not cell["viewpoints"] or not all(isinstance(n, str) and n and "/" not in n
+                                         for n, _ in cell["viewpoints"]):
+        raise ClientError(f"{path}: viewpoints need non-empty names without '/'")
     return cell
 
 
@@ -204,24 +271,37 @@ def connect(target, tls_ca=None, tls_cert=None, tls_key=None):
     return grpc.secure_channel(target, creds, options=options)
 
 
+def _number(settings, key, what, integer=False, lo=None, hi=None):
+    """settings[key] as a float or an int within [lo, hi], or a ClientError
+    naming the field (cell.json values go into fixed-width proto fields)."""
+    value = settings[key]
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ClientError(f"cell.json: {what}.{key} must be a finite number, not {value!r}")
+    if integer and value != int(value):
+        raise ClientError(f"cell.json: {what}.{key} must be a whole number, not {value!r}")
+    if (lo is not None and value < lo) or (hi is not None and value > hi):
+        raise ClientError(f"cell.json: {what}.{key} = {value!r} is outside [{lo}, {hi}]")
+    return int(value) if integer else float(value)
+
+
 def _header(cell, part_id, mesh_ref):
     h = pb.PartHeader(part_id=part_id, idempotency_key=part_id, part=mesh_ref,
                       world_from_part=cell["world_from_part"], return_deviations=False, return_png=False)
     e = cell["error_map"]
     if cell["tolerance_mm"] is not None:
-        h.error_map.tolerance_mm = float(cell["tolerance_mm"])
+        h.error_map.tolerance_mm = _number(cell, "tolerance_mm", "cell", lo=0)
     for key in ("max_distance_mm", "allowed_fraction_outside"):
         if key in e:
-            setattr(h.error_map, key, float(e[key]))
+            setattr(h.error_map, key, _number(e, key, "error_map", lo=0))
     if "histogram_bins" in e:
-        h.error_map.histogram_bins = int(e["histogram_bins"])
+        h.error_map.histogram_bins = _number(e, "histogram_bins", "error_map", True, 0, 2**31 - 1)
     f = cell["filter"]
     h.skip_filter = not f.get("enabled", True)
     if "link_distance_mm" in f:
-        h.filter.link_distance_mm = float(f["link_distance_mm"])
+        h.filter.link_distance_mm = _number(f, "link_distance_mm", "filter", lo=0)
     for key in ("min_cluster_points", "connectivity"):
         if key in f:
-            setattr(h.filter, key, int(f[key]))
+            setattr(h.filter, key, _number(f, key, "filter", True, 0, 2**32 - 1))
     return h
 
 

@@ -242,6 +242,57 @@ class PythonClientTest(unittest.TestCase):
         with self.assertRaisesRegex(sc.ClientError, "not an STL"):
             sc.read_stl(os.path.join(self.root, "junk.stl"))
 
+    def test_readers_refuse_malformed_files_with_a_message(self):
+        import surfinspect_client as sc
+
+        def pcd(body):
+            return (b"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+                    b"WIDTH 2\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\n" + body)
+        two = struct.pack("<6f", 1, 2, 3, 4, 5, 6)
+        bad_pcd = {
+            "not a keyword first": (b"hello\n" + pcd(b"DATA binary\n" + two), "unknown PCD header"),
+            "garbage COUNT, second header": (
+                pcd(b"DATA binary\n" + two).replace(b"COUNT 1 1 1", b"COUNT a b c") +
+                b"VERSION 0.7\n", "malformed PCD header"),
+            "repeated key": (pcd(b"WIDTH 2\nDATA binary\n" + two), "repeated or out of order"),
+            "negative sizes": (pcd(b"DATA binary\n").replace(b"WIDTH 2", b"WIDTH -2")
+                               .replace(b"HEIGHT 1", b"HEIGHT -1"), "positive integer"),
+            "POINTS disagrees": (pcd(b"DATA binary\n" + two).replace(b"POINTS 2", b"POINTS 3"),
+                                 "POINTS is not"),
+            "fields disagree": (pcd(b"DATA binary\n" + two).replace(b"SIZE 4 4 4", b"SIZE 4 4"),
+                                "bad PCD sizes"),
+            "infinite point": (pcd(b"DATA ascii\n1 2 3\ninf 5 6\n"), "infinite"),
+            "short ascii row": (pcd(b"DATA ascii\n1 2 3\n44 55\n"), "bad point line"),
+            "no DATA": (b"# a comment\n" * 10000, "truncated PCD header"),
+        }
+        for name, (data, message) in bad_pcd.items():
+            path = os.path.join(self.root, "bad.pcd")
+            with open(path, "wb") as f:
+                f.write(data)
+            with self.assertRaisesRegex(sc.ClientError, message, msg=name):
+                sc.read_pcd(path)
+        quad = ("solid q\nfacet normal 0 0 1\nouter loop\n" +
+                "".join(f"vertex {x} {y} 0\n" for x, y in ((0, 0), (1, 0), (1, 1), (0, 1))) +
+                "endloop\nendfacet\nendsolid q\n")
+        bad_stl = {"quad facet": (quad, "facet with 4 vertices"),
+                   "nan vertex": (quad.replace("vertex 0 1 0\n", "").replace("vertex 1 1 0", "vertex nan 1 0"),
+                                  "not finite")}
+        for name, (text, message) in bad_stl.items():
+            path = os.path.join(self.root, "bad.stl")
+            with open(path, "w") as f:
+                f.write(text)
+            with self.assertRaisesRegex(sc.ClientError, message, msg=name):
+                sc.read_stl(path)
+
+    def test_cell_numbers_out_of_range_are_refused_not_wrapped(self):
+        import surfinspect_client as sc
+        for section, key, value in (("filter", "min_cluster_points", -5), ("filter", "connectivity", 1e300),
+                                    ("error_map", "histogram_bins", 1e300), ("filter", "link_distance_mm", "x")):
+            cell = {"world_from_part": None, "tolerance_mm": None, "error_map": {}, "filter": {}}
+            cell[section] = {key: value}
+            with self.assertRaisesRegex(sc.ClientError, f"{section}.{key}", msg=f"{key}={value!r}"):
+                sc._header(cell, "p", None)
+
 
 if __name__ == "__main__":
     BIN = os.path.abspath(sys.argv[1])
