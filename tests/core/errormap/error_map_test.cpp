@@ -1,3 +1,6 @@
+// Covers core/errormap/error_map.cpp (ComputeErrorMap, AutoColorRange),
+// core/errormap/error_map_output.cpp (DeviationColor, the PLY, CSV and JSON report) and
+// core/errormap/error_map_png.cpp (RenderErrorMap, WriteErrorMapPng, ThinnestAxis).
 #include "core/errormap/error_map.h"
 
 #include <gtest/gtest.h>
