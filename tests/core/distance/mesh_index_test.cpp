@@ -598,7 +598,8 @@ TEST(MeshIndexBatch, QueryClosestEachCallsTheSinkOnceForEveryIndex) {
   std::vector<Eigen::Vector3f> shuffled = cloud.points;
   std::shuffle(shuffled.begin(), shuffled.end(), std::mt19937_64(4));
   const PointCloud unorganized = PointCloud::Unorganized(shuffled);
-  for (const PointCloud* points : {&cloud, &unorganized}) {
+  const PointCloud& organized = cloud;
+  for (const PointCloud* points : {&organized, &unorganized}) {
     BatchQuerySettings s;
     s.threads = 2;
     s.max_distance_mm = 0.6;
@@ -614,7 +615,9 @@ TEST(MeshIndexBatch, QueryClosestEachCallsTheSinkOnceForEveryIndex) {
       ASSERT_EQ(calls[i].load(), 1) << i;
       const ClosestPoint single = index->Closest(points->points[i].cast<double>(), 0.6);
       EXPECT_EQ(streamed[i].triangle_id, single.triangle_id) << i;
-      if (!PointCloud::IsValid(points->points[i])) EXPECT_FALSE(streamed[i].matched()) << i;
+      if (!PointCloud::IsValid(points->points[i])) {
+        EXPECT_FALSE(streamed[i].matched()) << i;
+      }
     }
   }
   std::atomic<bool> cancel{true};
