@@ -1,4 +1,4 @@
-// Closest-point throughput of the mesh index (issue 5): 1M points within
+// Closest-point throughput of the mesh index: 1M points within
 // 1 mm of a 150k-triangle torus, 2 threads, against Open3D 0.16's
 // RaycastingScene::ComputeDistance on the same points in the same run
 // (goal: >= 5x Open3D's throughput), plus an organized, scan-ordered 1000 x

@@ -1,4 +1,4 @@
-// Link-clustering filter (issue 4) against PCL on the same points with the
+// Link-clustering filter against PCL on the same points with the
 // same link distance (the default, 0.5 mm), single thread:
 //  * a 1024x768 organized demo scan (noise, 0.3% pulses, stripes): our grid
 //    path (8- and 4-neighbours) vs PCL OrganizedConnectedComponentSegmentation

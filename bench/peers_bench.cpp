@@ -1,7 +1,7 @@
-// The peer comparison table (issue 9): each row runs our code and the tool a
+// The peer comparison table: each row runs our code and the tool a
 // user would otherwise pick (PCL, Open3D) on the same generated data, back to
 // back in this one process, checks that they agree, and prints the ratio
-// next to the goal from the row's own issue, marked met or not met from the
+// next to the row's goal, marked met or not met from the
 // numbers measured here. A peer that is not installed is reported as
 // skipped. Writes the markdown to RESULTS_DIR/latest.md (atomically) with
 // the CPU model and core count.

@@ -1,5 +1,5 @@
 // Ray-cast throughput of the virtual area sensor: a 1024x768 scan of a
-// 100k-triangle wavy sheet from 400 mm (goal: < 0.5 s on 2 cores, issue 3).
+// 100k-triangle wavy sheet from 400 mm (goal: < 0.5 s on 2 cores).
 // Includes the BVH build, as every SimulateScan call does.
 #include <benchmark/benchmark.h>
 

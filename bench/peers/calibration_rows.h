@@ -1,4 +1,4 @@
-// Gauge calibration (issue 6) against PCL and Open3D ICP on the same scan:
+// Gauge calibration against PCL and Open3D ICP on the same scan:
 // the demo cell's v1 gauge scan (1024x768, 0.015 mm noise, no outliers so
 // the peers need no filter), the truth gauge_from_sensor, and two starting
 // guesses: the truth moved by 1 mm / 0.5 deg (a case the peers can handle),

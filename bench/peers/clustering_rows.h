@@ -1,4 +1,4 @@
-// Link clustering (issue 4) against PCL on the same points and the same link
+// Link clustering against PCL on the same points and the same link
 // distance (0.5 mm), single thread on both sides:
 //  * a 1024x768 organized demo scan (noise, 0.3% pulses, stripes): our grid
 //    path vs PCL OrganizedConnectedComponentSegmentation with
@@ -148,7 +148,7 @@ inline void AddClusteringRows(std::vector<Row>& rows) {
 
   const double faster_pcl = std::min(pcl_org, pcl_ece_scan);
   const double ratio_scan = faster_pcl / ours8;
-  // Two goals from issue 4 on this row: the absolute time and the ratio to
+  // Two goals on this row: the absolute time and the ratio to
   // the faster of the two PCL methods (measured here, not assumed).
   const bool fast = ours8 <= 5e-3, far_ahead = ratio_scan >= 20;
   rows.push_back(

@@ -1,4 +1,4 @@
-// Closest-point distances (issue 5) against Open3D 0.16's
+// Closest-point distances against Open3D 0.16's
 // RaycastingScene::ComputeDistance on the same points and mesh: a torus
 // (R = 100 mm, r = 30 mm) tessellated into ~150k triangles, 10^6 points
 // within +-0.5 mm of it, once in scan order (a 1000x1000 (u, v) raster,

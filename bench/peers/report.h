@@ -1,7 +1,7 @@
 // The comparison table of bench/peers_bench.cpp: timing helpers, one row per
-// comparison (ours, the peer, their ratio, an agreement check and the goal
-// from the row's own issue, marked met or not met from the measured
-// numbers), and the machine description written with it.
+// comparison (ours, the peer, their ratio, an agreement check and the row's
+// goal, marked met or not met from the measured numbers), and the machine
+// description written with it.
 #pragma once
 
 #include <algorithm>
@@ -64,7 +64,7 @@ struct Row {
   std::string peer;   // "skipped (...)" when the peer is not installed
   std::string ratio;  // peer time / our time, or "—"
   std::string agreement;
-  std::string goal;  // as stated in the row's issue
+  std::string goal;  // the row's target, in words
   std::string met;   // "met" / "**not met**" / "—"
 };
 

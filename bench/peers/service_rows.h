@@ -1,9 +1,9 @@
-// The scan simulator's ray-cast throughput (issue 3; no peer: Open3D 0.16's
-// cast_rays returns no hits with Debian's Embree, see FIELD-NOTES) and the
-// service overhead (issue 7): a 1024x768 scan's ErrorMap in-process and
-// through a surfinspectd child process on loopback (mesh cached there by
-// hash before timing), and one 9.4 MB organized cloud streamed in 1 MB
-// chunks until the server reports it received.
+// The scan simulator's ray-cast throughput (no peer: Open3D 0.16's
+// cast_rays returns no hits with Debian's Embree, which has ray masks
+// compiled in) and the service overhead: a 1024x768 scan's ErrorMap
+// in-process and through a surfinspectd child process on loopback (mesh
+// cached there by hash before timing), and one 9.4 MB organized cloud
+// streamed in 1 MB chunks until the server reports it received.
 #pragma once
 
 #include <grpcpp/grpcpp.h>

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """End-to-end and fault tests of cell-agent against real surfinspectd
-processes on loopback (issue 8): verdicts and dent depths against the
+processes on loopback: verdicts and dent depths against the
 simulated truth, server killed mid-part, agent killed mid-part, a corrupt
 scan quarantined, two replicas with one killed. Standard library only.
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Every CLI step run in-process and with --server writes the same files:
-byte for byte, except the wall-clock fields of the JSON reports (issue 7).
+byte for byte, except the wall-clock fields of the JSON reports.
 
 usage: remote_outputs_test.py BIN_DIR
 """

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The deployment files (issue 10), checked as far as this machine allows:
+"""The deployment files, checked as far as this machine allows:
 Kubernetes manifests and compose are parsed (PyYAML) and their required keys
 checked, including that the probes are native gRPC probes on the gRPC port
 and that the grace period outlasts the server's drain; every SURFINSPECT_*

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Scale-out on one machine (issue 10): three surfinspectd replicas on
+"""Scale-out on one machine: three surfinspectd replicas on
 loopback ports, one cell-agent with round_robin over all three, six parts,
 and the replica that is computing a part is killed mid-run. Every part must
 end with results exactly once, and the replicas' own Prometheus counters

@@ -1,8 +1,13 @@
+// Covers core/distance/mesh_index.cpp (MeshIndex::Closest against brute force, signs against
+// winding numbers) and core/distance/mesh_index_batch.cpp (QueryClosest and QueryClosestEach:
+// one and many threads, coherent start, Morton order, cancel, bad input).
 #include "core/distance/mesh_index.h"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <atomic>
 #include <random>
 
 #include "tests/support/test_meshes.h"
@@ -580,6 +585,48 @@ TEST(MeshIndexBatch, CancelAndBadInput) {
   auto empty = QueryClosest(*index, PointCloud{}, Eigen::Isometry3d::Identity(), {});
   ASSERT_TRUE(empty.ok());
   EXPECT_TRUE(empty->empty());
+}
+
+TEST(MeshIndexBatch, QueryClosestEachCallsTheSinkOnceForEveryIndex) {
+  const TriangleMesh sheet = testing::HeightField(
+      0, 30, 0, 20, 31, 21, [](double x, double y) { return 0.5 * std::sin(x / 5) + 0.1 * y; });
+  auto index = BuildOrDie(sheet);
+  ASSERT_TRUE(index);
+  PointCloud cloud = OrganizedCloudNear(sheet, 50, 30, 3);
+  for (std::size_t i = 0; i < cloud.size(); i += 11)
+    cloud.points[i] = Eigen::Vector3f::Constant(NAN);
+  std::vector<Eigen::Vector3f> shuffled = cloud.points;
+  std::shuffle(shuffled.begin(), shuffled.end(), std::mt19937_64(4));
+  const PointCloud unorganized = PointCloud::Unorganized(shuffled);
+  const PointCloud& organized = cloud;
+  for (const PointCloud* points : {&organized, &unorganized}) {
+    BatchQuerySettings s;
+    s.threads = 2;
+    s.max_distance_mm = 0.6;
+    std::vector<std::atomic<int>> calls(points->size());
+    std::vector<ClosestPoint> streamed(points->size());
+    const absl::Status st = QueryClosestEach(*index, *points, Eigen::Isometry3d::Identity(), s,
+                                             nullptr, [&](std::size_t i, const ClosestPoint& r) {
+                                               calls[i].fetch_add(1);
+                                               streamed[i] = r;
+                                             });
+    ASSERT_TRUE(st.ok()) << st;
+    for (std::size_t i = 0; i < points->size(); ++i) {
+      ASSERT_EQ(calls[i].load(), 1) << i;
+      const ClosestPoint single = index->Closest(points->points[i].cast<double>(), 0.6);
+      EXPECT_EQ(streamed[i].triangle_id, single.triangle_id) << i;
+      if (!PointCloud::IsValid(points->points[i])) {
+        EXPECT_FALSE(streamed[i].matched()) << i;
+      }
+    }
+  }
+  std::atomic<bool> cancel{true};
+  std::atomic<int> sunk{0};
+  EXPECT_EQ(QueryClosestEach(*index, cloud, Eigen::Isometry3d::Identity(), {}, &cancel,
+                             [&](std::size_t, const ClosestPoint&) { ++sunk; })
+                .code(),
+            absl::StatusCode::kCancelled);
+  EXPECT_LT(sunk.load(), static_cast<int>(cloud.size()));
 }
 
 }  // namespace

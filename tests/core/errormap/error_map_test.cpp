@@ -1,3 +1,6 @@
+// Covers core/errormap/error_map.cpp (ComputeErrorMap, AutoColorRange),
+// core/errormap/error_map_output.cpp (DeviationColor, the PLY, CSV and JSON report) and
+// core/errormap/error_map_png.cpp (RenderErrorMap, WriteErrorMapPng, ThinnestAxis).
 #include "core/errormap/error_map.h"
 
 #include <gtest/gtest.h>
@@ -470,7 +473,7 @@ TEST(ErrorMapOutput, PngOfAMergedCloudLooksAlongTheThinnestAxis) {
   EXPECT_GT(blue, 1000u);
 }
 
-// Acceptance (issue 5): on demo-part scans with planted dents, noise-free,
+// On demo-part scans with planted dents, noise-free,
 // the deviation at the dent centre is within 5 um of the planted depth.
 TEST(ErrorMapDemo, DentCentreDeviationIsThePlantedDepth) {
   const DemoCell cell = MakeDemoCell();

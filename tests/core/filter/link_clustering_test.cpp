@@ -1,3 +1,8 @@
+// Covers core/filter/link_clustering.cpp (ClusterLinks, ApplyFilter, the settings checks),
+// core/filter/link_clustering_grid.cpp (ClusterLinksOrganized: BFS oracle on random grids,
+// mask-word borders, snakes, single rows and columns, cancel) and
+// core/filter/link_clustering_unorganized.cpp (ClusterLinksUnorganized: pairwise oracle,
+// cell borders and diagonals, the 2^21-cell limit, cancel).
 #include "core/filter/link_clustering.h"
 
 #include <gtest/gtest.h>
