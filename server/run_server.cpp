@@ -12,6 +12,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/io/atomic_file.h"
+#include "server/fault_hook.h"
 
 namespace surfinspect::server {
 namespace {
@@ -46,6 +47,8 @@ absl::Status RunServer(const ServerOptions& o) {
     return absl::InvalidArgumentError("--max-message-mb must be in 1..2000");
   if (o.service.threads < 1 || o.service.max_admitted_calls < 1)
     return absl::InvalidArgumentError("--threads and --max-calls must be >= 1");
+  for (const std::string& spec : o.fault_inject)
+    if (absl::Status st = ArmFault(spec); !st.ok()) return st;
   auto creds = Credentials(o);
   if (!creds.ok()) return creds.status();
   auto metrics = Metrics::Create(o.metrics_listen);
