@@ -159,8 +159,8 @@ std::string InspectionService::RequestId(const grpc::CallbackServerContext* ctx)
 }
 
 void InspectionService::LogCall(const std::string& request_id, const std::string& method,
-                                const std::string& peer, uint64_t points, const grpc::Status& st,
-                                double seconds, double stop_ms) {
+                                const std::string& peer, uint64_t points,
+                                const grpc::Status& status, double seconds, double stop_ms) {
   if (config_.json_logs) {
     // spdlog does not escape JSON; nlohmann does.
     nlohmann::json line = {{"event", "rpc"},
@@ -168,8 +168,8 @@ void InspectionService::LogCall(const std::string& request_id, const std::string
                            {"method", method},
                            {"peer", peer},
                            {"points", points},
-                           {"code", CodeName(st.error_code())},
-                           {"message", st.error_message()},
+                           {"code", CodeName(status.error_code())},
+                           {"message", status.error_message()},
                            {"seconds", seconds}};
     if (!std::isnan(stop_ms)) line["stopped_after_cancel_ms"] = stop_ms;
     spdlog::info("{}", line.dump());
@@ -178,12 +178,12 @@ void InspectionService::LogCall(const std::string& request_id, const std::string
   const std::string stopped =
       std::isnan(stop_ms) ? ""
                           : fmt::format(", work stopped {:.1f} ms after the cancellation", stop_ms);
-  if (st.ok())
+  if (status.ok())
     spdlog::info("[{}] {} from {}: OK, {} points, {:.3f} s{}", request_id, method, peer, points,
                  seconds, stopped);
   else
     spdlog::warn("[{}] {} from {}: {} ({}), {} points, {:.3f} s{}", request_id, method, peer,
-                 CodeName(st.error_code()), st.error_message(), points, seconds, stopped);
+                 CodeName(status.error_code()), status.error_message(), points, seconds, stopped);
 }
 
 grpc::ServerUnaryReactor* InspectionService::RunHeavy(grpc::CallbackServerContext* ctx,
