@@ -9,8 +9,23 @@
 namespace surfinspect::wire {
 namespace {
 
+static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__,
+              "the wire's packed arrays and xyz bytes are the host's little-endian memory");
+
 absl::Status Invalid(const std::string& field, absl::string_view why) {
   return absl::InvalidArgumentError(absl::StrCat(field, ": ", why));
+}
+
+template <typename T>
+std::string Pack(const std::vector<T>& v) {
+  return std::string(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+}
+
+template <typename T>
+std::vector<T> Unpack(const std::string& bytes) {
+  std::vector<T> v(bytes.size() / sizeof(T));
+  if (!v.empty()) std::memcpy(v.data(), bytes.data(), v.size() * sizeof(T));
+  return v;
 }
 
 }  // namespace
@@ -252,14 +267,67 @@ void ErrorMapSettingsToProto(const ErrorMapSettings& s, v1::ErrorMapSettings* ms
   msg->set_split_components(s.split_components);
 }
 
-std::string PackFloats(const std::vector<float>& v) {
-  return std::string(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(float));
+void FilterResultToProto(const PointCloud& filtered, const LinkClusteringResult& r,
+                         v1::FilterResponse* msg) {
+  CloudToProto(filtered, msg->mutable_cloud());
+  FilterStatsToProto(r, msg->mutable_stats());
+  msg->set_kept_mask(Pack(r.kept_mask));
 }
 
-std::vector<float> UnpackFloats(const std::string& bytes) {
-  std::vector<float> v(bytes.size() / sizeof(float));
-  std::memcpy(v.data(), bytes.data(), v.size() * sizeof(float));
-  return v;
+void MergedCloudToProto(const MergedCloud& merged, v1::RegisterResponse* msg) {
+  CloudToProto(merged.cloud_in_world, msg->mutable_merged());
+  msg->set_view_index(PackUint16(merged.view_id));
+  msg->set_grid_index(PackUint32(merged.grid_index));
+  msg->clear_points_per_view();
+  for (std::size_t n : merged.points_per_view) msg->add_points_per_view(n);
 }
+
+const char* VerdictName(const ErrorMapResult& map) { return map.verdict.pass ? "pass" : "fail"; }
+
+void ErrorMapToProto(const ErrorMapResult& map, const ErrorMapSettings& settings,
+                     bool with_deviations, v1::ErrorMapResponse* msg) {
+  msg->set_report_json(ErrorMapReportText(map, settings));
+  msg->set_verdict(VerdictName(map));
+  if (with_deviations) msg->set_deviations(PackFloats(map.deviation_mm));
+}
+
+void ViewOutcomeToProto(const ViewOutcome& view, v1::ViewSummary* msg) {
+  msg->set_name(view.name);
+  msg->set_valid_points(view.valid_points);
+  msg->set_removed_points(view.removed_points);
+}
+
+void InspectionResultToProto(const std::string& part_id, const InspectionResult& result,
+                             const ErrorMapSettings& settings, bool with_deviations,
+                             v1::InspectResult* msg) {
+  msg->set_part_id(part_id);
+  msg->set_verdict(VerdictName(result.error_map));
+  msg->set_report_json(ErrorMapReportText(result.error_map, settings));
+  msg->clear_views();
+  for (const ViewOutcome& v : result.views) ViewOutcomeToProto(v, msg->add_views());
+  if (with_deviations) {
+    msg->set_deviations(PackFloats(result.error_map.deviation_mm));
+    CloudToProto(result.merged.cloud_in_world, msg->mutable_merged());
+  }
+}
+
+v1::Progress::Stage StageToProto(InspectionStage stage) {
+  switch (stage) {
+    case InspectionStage::kViewFiltered:
+      return v1::Progress::STAGE_VIEW_FILTERED;
+    case InspectionStage::kViewRegistered:
+      return v1::Progress::STAGE_VIEW_REGISTERED;
+    case InspectionStage::kErrorMap:
+      return v1::Progress::STAGE_ERROR_MAP;
+  }
+  return v1::Progress::STAGE_ERROR_MAP;
+}
+
+std::string PackFloats(const std::vector<float>& v) { return Pack(v); }
+std::vector<float> UnpackFloats(const std::string& bytes) { return Unpack<float>(bytes); }
+std::string PackUint16(const std::vector<uint16_t>& v) { return Pack(v); }
+std::vector<uint16_t> UnpackUint16(const std::string& bytes) { return Unpack<uint16_t>(bytes); }
+std::string PackUint32(const std::vector<uint32_t>& v) { return Pack(v); }
+std::vector<uint32_t> UnpackUint32(const std::string& bytes) { return Unpack<uint32_t>(bytes); }
 
 }  // namespace surfinspect::wire

@@ -2,7 +2,8 @@
 // core types, used by the server and by the clients alike (so both sides
 // agree on every byte). Every "FromProto" validates what it reads and names
 // the offending field in an InvalidArgument status; limits give
-// ResourceExhausted.
+// ResourceExhausted. Every "ToProto" builds a message from a core result,
+// so a handler reads: parse (FromProto) -> core -> convert (ToProto).
 #pragma once
 
 #include <Eigen/Geometry>
@@ -11,7 +12,9 @@
 #include "absl/status/statusor.h"
 #include "core/errormap/error_map.h"
 #include "core/filter/link_clustering.h"
+#include "core/pipeline/inspection.h"
 #include "core/registration/calibration.h"
+#include "core/registration/registration.h"
 #include "core/types/point_cloud.h"
 #include "core/types/triangle_mesh.h"
 #include "surfinspect/v1/inspection.pb.h"
@@ -85,8 +88,37 @@ absl::StatusOr<ErrorMapSettings> ErrorMapSettingsFromProto(const v1::ErrorMapSet
                                                            const std::string& field);
 void ErrorMapSettingsToProto(const ErrorMapSettings& s, v1::ErrorMapSettings* msg);
 
-// Packs float32 / uint16 / uint32 arrays little-endian.
+// ---- results ----
+// The filtered cloud, the statistics and the kept mask (one byte per input
+// point: 1 kept, 0 removed or no data).
+void FilterResultToProto(const PointCloud& filtered, const LinkClusteringResult& r,
+                         v1::FilterResponse* msg);
+// The merged cloud, its per-point view index (uint16) and grid index
+// (uint32), and the points per view. best_fit_correction is the caller's.
+void MergedCloudToProto(const MergedCloud& merged, v1::RegisterResponse* msg);
+// "pass" or "fail", as in the JSON report.
+const char* VerdictName(const ErrorMapResult& map);
+// The report JSON text, the verdict and, when `with_deviations`, the
+// per-point deviations. The PNG is the caller's.
+void ErrorMapToProto(const ErrorMapResult& map, const ErrorMapSettings& settings,
+                     bool with_deviations, v1::ErrorMapResponse* msg);
+void ViewOutcomeToProto(const ViewOutcome& view, v1::ViewSummary* msg);
+// As ErrorMapToProto, plus the part id and the per-view summaries; with
+// `with_deviations` also the merged cloud (world frame) they belong to.
+void InspectionResultToProto(const std::string& part_id, const InspectionResult& result,
+                             const ErrorMapSettings& settings, bool with_deviations,
+                             v1::InspectResult* msg);
+v1::Progress::Stage StageToProto(InspectionStage stage);
+
+// ---- packed arrays ----
+// float32 / uint16 / uint32 arrays as little-endian bytes (the host order on
+// every target surfinspect builds for; convert.cpp asserts it). An Unpack
+// ignores a trailing partial element.
 std::string PackFloats(const std::vector<float>& v);
 std::vector<float> UnpackFloats(const std::string& bytes);
+std::string PackUint16(const std::vector<uint16_t>& v);
+std::vector<uint16_t> UnpackUint16(const std::string& bytes);
+std::string PackUint32(const std::vector<uint32_t>& v);
+std::vector<uint32_t> UnpackUint32(const std::string& bytes);
 
 }  // namespace surfinspect::wire

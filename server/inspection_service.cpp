@@ -15,6 +15,7 @@
 #include "core/registration/registration.h"
 #include "core/types/transform.h"
 #include "server/cancel_signal.h"
+#include "server/guarded.h"
 #include "server/status_mapping.h"
 
 namespace surfinspect::server {
@@ -24,7 +25,8 @@ using Clock = std::chrono::steady_clock;
 
 // One reactor per unary heavy call. The work runs on the pool; Finish is
 // the last thing it touches, because OnDone (which deletes the reactor) may
-// run as soon as Finish is called.
+// run as soon as Finish is called. Start, Run and Done run under Guarded
+// (server/guarded.h): an exception ends the call with its status.
 class HeavyCall final : public grpc::ServerUnaryReactor {
  public:
   using Work = std::function<grpc::Status(const std::atomic<bool>& cancel)>;
@@ -39,36 +41,44 @@ class HeavyCall final : public grpc::ServerUnaryReactor {
         start_(Clock::now()) {}
 
   void Start() {
-    if (grpc::Status auth = service_->Authorize(ctx_); !auth.ok()) return Done(auth);
-    service_->metrics()->CallStarted();
-    admitted_ = true;
-    if (!service_->pool().TrySubmit([this] { Run(); }))
-      Done(grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
-                        absl::StrCat("server busy: ", service_->config().max_admitted_calls,
-                                     " heavy calls already admitted; retry with backoff")));
+    const grpc::Status st = Guarded(method_, "Start", [this] { return Admit(); });
+    if (!st.ok()) Done(st);
   }
   void OnCancel() override { cancel_.Raise(); }
   void OnDone() override { delete this; }
 
  private:
+  // OK once the work is on the pool; submitting is the last step, so an
+  // exception before it leaves nothing running.
+  grpc::Status Admit() {
+    if (grpc::Status auth = service_->Authorize(ctx_); !auth.ok()) return auth;
+    service_->metrics()->CallStarted();
+    admitted_ = true;
+    if (!service_->pool().TrySubmit([this] { Run(); }))
+      return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                          absl::StrCat("server busy: ", service_->config().max_admitted_calls,
+                                       " heavy calls already admitted; retry with backoff"));
+    return grpc::Status::OK;
+  }
   void Run() {
-    grpc::Status st;
-    try {
-      st = cancel_.raised() ? grpc::Status(grpc::StatusCode::CANCELLED, "cancelled before start")
-                            : work_(cancel_.flag());
-    } catch (const std::exception& e) {  // never let an exception cross the RPC
-      st = grpc::Status(grpc::StatusCode::INTERNAL, absl::StrCat("internal error: ", e.what()));
-    }
+    const grpc::Status st = Guarded(method_, "Run", [this] {
+      return cancel_.raised() ? grpc::Status(grpc::StatusCode::CANCELLED, "cancelled before start")
+                              : work_(cancel_.flag());
+    });
     Done(st);
   }
+  // If logging the call throws, the call ends with that status instead.
   void Done(const grpc::Status& st) {
+    const grpc::Status logged = Guarded(method_, "Done", [&] { LogAndCount(st); });
+    if (admitted_) service_->metrics()->CallEnded();
+    Finish(logged.ok() ? st : logged);
+  }
+  void LogAndCount(const grpc::Status& st) {
     const double seconds = std::chrono::duration<double>(Clock::now() - start_).count();
     service_->LogCall(request_id_, method_, ctx_->peer(), points_, st, seconds,
                       cancel_.MillisecondsSinceRaised());
     service_->metrics()->RecordRpc(method_, CodeName(st.error_code()), seconds);
     if (st.ok()) service_->metrics()->AddPoints(points_);
-    if (admitted_) service_->metrics()->CallEnded();
-    Finish(st);
   }
 
   InspectionService* service_;
@@ -149,8 +159,8 @@ std::string InspectionService::RequestId(const grpc::CallbackServerContext* ctx)
 }
 
 void InspectionService::LogCall(const std::string& request_id, const std::string& method,
-                                const std::string& peer, uint64_t points, const grpc::Status& st,
-                                double seconds, double stop_ms) {
+                                const std::string& peer, uint64_t points,
+                                const grpc::Status& status, double seconds, double stop_ms) {
   if (config_.json_logs) {
     // spdlog does not escape JSON; nlohmann does.
     nlohmann::json line = {{"event", "rpc"},
@@ -158,8 +168,8 @@ void InspectionService::LogCall(const std::string& request_id, const std::string
                            {"method", method},
                            {"peer", peer},
                            {"points", points},
-                           {"code", CodeName(st.error_code())},
-                           {"message", st.error_message()},
+                           {"code", CodeName(status.error_code())},
+                           {"message", status.error_message()},
                            {"seconds", seconds}};
     if (!std::isnan(stop_ms)) line["stopped_after_cancel_ms"] = stop_ms;
     spdlog::info("{}", line.dump());
@@ -168,18 +178,25 @@ void InspectionService::LogCall(const std::string& request_id, const std::string
   const std::string stopped =
       std::isnan(stop_ms) ? ""
                           : fmt::format(", work stopped {:.1f} ms after the cancellation", stop_ms);
-  if (st.ok())
+  if (status.ok())
     spdlog::info("[{}] {} from {}: OK, {} points, {:.3f} s{}", request_id, method, peer, points,
                  seconds, stopped);
   else
     spdlog::warn("[{}] {} from {}: {} ({}), {} points, {:.3f} s{}", request_id, method, peer,
-                 CodeName(st.error_code()), st.error_message(), points, seconds, stopped);
+                 CodeName(status.error_code()), status.error_message(), points, seconds, stopped);
 }
 
 grpc::ServerUnaryReactor* InspectionService::RunHeavy(grpc::CallbackServerContext* ctx,
                                                       const char* method, uint64_t points,
                                                       Work work) {
-  auto* call = new HeavyCall(this, ctx, method, points, std::move(work));
+  HeavyCall* call = nullptr;
+  const grpc::Status st = Guarded(
+      method, "Accept", [&] { call = new HeavyCall(this, ctx, method, points, std::move(work)); });
+  if (!st.ok()) {  // no reactor of our own: the context's default one reports the status
+    grpc::ServerUnaryReactor* fallback = ctx->DefaultReactor();
+    fallback->Finish(st);
+    return fallback;
+  }
   call->Start();
   return call;
 }
@@ -197,9 +214,7 @@ grpc::ServerUnaryReactor* InspectionService::Filter(grpc::CallbackServerContext*
     if (!clusters.ok()) return FromCore(clusters.status());
     auto filtered = ApplyFilter(*cloud, *clusters);
     if (!filtered.ok()) return FromCore(filtered.status());
-    wire::CloudToProto(*filtered, resp->mutable_cloud());
-    wire::FilterStatsToProto(*clusters, resp->mutable_stats());
-    resp->mutable_kept_mask()->assign(clusters->kept_mask.begin(), clusters->kept_mask.end());
+    wire::FilterResultToProto(*filtered, *clusters, resp);
     return grpc::Status::OK;
   });
 }
@@ -282,12 +297,7 @@ grpc::ServerUnaryReactor* InspectionService::Register(grpc::CallbackServerContex
           merged->cloud_in_world = TransformCloud(merged->cloud_in_world, fit->correction);
           wire::TransformToProto(fit->correction, resp->mutable_best_fit_correction());
         }
-        wire::CloudToProto(merged->cloud_in_world, resp->mutable_merged());
-        resp->mutable_view_index()->assign(reinterpret_cast<const char*>(merged->view_id.data()),
-                                           merged->view_id.size() * sizeof(uint16_t));
-        resp->mutable_grid_index()->assign(reinterpret_cast<const char*>(merged->grid_index.data()),
-                                           merged->grid_index.size() * sizeof(uint32_t));
-        for (std::size_t n : merged->points_per_view) resp->add_points_per_view(n);
+        wire::MergedCloudToProto(*merged, resp);
         return grpc::Status::OK;
       });
 }
@@ -307,9 +317,7 @@ grpc::ServerUnaryReactor* InspectionService::ErrorMap(grpc::CallbackServerContex
     if (grpc::Status st = ResolveMesh(ctx, req->part(), "part", &part); !st.ok()) return st;
     auto map = ComputeErrorMap(*part, *cloud, *world_from_part, *settings, &cancel);
     if (!map.ok()) return FromCore(map.status());
-    resp->set_report_json(ErrorMapReportText(*map, *settings));
-    resp->set_verdict(map->verdict.pass ? "pass" : "fail");
-    if (req->return_deviations()) resp->set_deviations(wire::PackFloats(map->deviation_mm));
+    wire::ErrorMapToProto(*map, *settings, req->return_deviations(), resp);
     if (req->return_png()) {
       auto png = ErrorMapPngBytes(*cloud, *world_from_part, *map, part->mesh());
       if (!png.ok()) return FromCore(png.status());

@@ -1,9 +1,12 @@
-// InspectionService: the thin gRPC face of core. Each RPC validates its
-// request through proto/convert (naming the bad field), runs the core step
-// on the work pool (admission control, shared TBB arena), maps the core
-// status through server/status_mapping, and logs and counts the call.
-// Callback API: unary calls are HeavyCall reactors, Inspect is an
-// InspectReactor (server/inspect_reactor.h) that holds the stream's state.
+// InspectionService: the thin gRPC face of core. Each RPC parses and
+// validates its request through proto/convert (naming the bad field), runs
+// the core step on the work pool (admission control, shared TBB arena),
+// builds the response through proto/convert, maps the core status through
+// server/status_mapping, and logs and counts the call. Callback API: unary
+// calls are HeavyCall reactors, Inspect is an InspectReactor
+// (server/inspect_reactor.h) that holds the stream's state; every callback
+// of either runs under Guarded (server/guarded.h), so an exception ends its
+// call with a status instead of crossing the RPC.
 #pragma once
 
 #include <grpcpp/grpcpp.h>

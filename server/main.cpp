@@ -6,28 +6,19 @@
 #include <csignal>
 #include <thread>
 
+#include "absl/status/statusor.h"
 #include "absl/strings/ascii.h"
 #include "core/io/atomic_file.h"
 #include "core/process/buffer_reuse.h"
 #include "core/process/quiet_consoles.h"
 #include "server/run_server.h"
 
-int main(int argc, char** argv) {
-  // Block SIGTERM/SIGINT before any thread exists (gRPC, TBB and the
-  // metrics listener start their own); RunServer waits for them with
-  // sigwait on one thread and drains.
-  sigset_t signals;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGTERM);
-  sigaddset(&signals, SIGINT);
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
-  surfinspect::ReuseFreedLargeBuffers();  // every call moves ~10 MB buffers
-  surfinspect::QuietDependencyConsoles();
-  surfinspect::server::ServerOptions o;
-  o.service.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  std::string token_file;
-  uint64_t mesh_cache_mb = 512;
-  CLI::App app{"surfinspectd: the surfinspect gRPC inspection service (stateless; mm)"};
+namespace {
+
+using surfinspect::server::ServerOptions;
+
+// Flags, each with its SURFINSPECT_* environment variable.
+void AddFlags(CLI::App& app, ServerOptions& o, std::string& token_file, uint64_t& mesh_cache_mb) {
   app.add_option("--listen", o.listen, "host:port (port 0 = any free port)")
       ->envname("SURFINSPECT_LISTEN")
       ->capture_default_str();
@@ -70,6 +61,39 @@ int main(int argc, char** argv) {
       ->envname("SURFINSPECT_AUTH_TOKEN_FILE");
   app.add_flag("--json-logs", o.service.json_logs, "one JSON object per log line")
       ->envname("SURFINSPECT_JSON_LOGS");
+  app.add_option("--fault-inject", o.fault_inject,
+                 "test hook: KIND:SITE[:COUNT] makes a guarded callback throw "
+                 "(server/fault_hook.h); never in production");
+}
+
+// The bearer token from `token_file` (surrounding whitespace stripped).
+absl::StatusOr<std::string> ReadToken(const std::string& token_file) {
+  auto token = surfinspect::ReadFileToString(token_file, 4096);
+  if (!token.ok()) return token.status();
+  std::string stripped(absl::StripAsciiWhitespace(*token));
+  if (stripped.empty()) return absl::InvalidArgumentError(token_file + ": the token file is empty");
+  return stripped;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Block SIGTERM/SIGINT before any thread exists (gRPC, TBB and the
+  // metrics listener start their own); RunServer waits for them with
+  // sigwait on one thread and drains.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  surfinspect::ReuseFreedLargeBuffers();  // every call moves ~10 MB buffers
+  surfinspect::QuietDependencyConsoles();
+  ServerOptions o;
+  o.service.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  std::string token_file;
+  uint64_t mesh_cache_mb = 512;
+  CLI::App app{"surfinspectd: the surfinspect gRPC inspection service (stateless; mm)"};
+  AddFlags(app, o, token_file, mesh_cache_mb);
   CLI11_PARSE(app, argc, argv);
 
   spdlog::set_default_logger(spdlog::stderr_color_mt("surfinspectd"));
@@ -77,16 +101,12 @@ int main(int argc, char** argv) {
     spdlog::set_pattern(R"({"time":"%Y-%m-%dT%H:%M:%S.%e%z","level":"%l","log":%v})");
   o.service.mesh_cache_bytes = mesh_cache_mb << 20;
   if (!token_file.empty()) {
-    auto token = surfinspect::ReadFileToString(token_file, 4096);
+    auto token = ReadToken(token_file);
     if (!token.ok()) {
       spdlog::error("{}", std::string(token.status().message()));
       return 2;
     }
-    o.service.auth_token = std::string(absl::StripAsciiWhitespace(*token));
-    if (o.service.auth_token.empty()) {
-      spdlog::error("{}: the token file is empty", token_file);
-      return 2;
-    }
+    o.service.auth_token = *std::move(token);
   }
   const absl::Status st = surfinspect::server::RunServer(o);
   if (!st.ok()) {

@@ -12,6 +12,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/io/atomic_file.h"
+#include "server/fault_hook.h"
 
 namespace surfinspect::server {
 namespace {
@@ -41,14 +42,16 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> Credentials(const Serve
 
 }  // namespace
 
-absl::Status RunServer(const ServerOptions& o) {
-  if (o.max_message_mb < 1 || o.max_message_mb > 2000)
+absl::Status RunServer(const ServerOptions& options) {
+  if (options.max_message_mb < 1 || options.max_message_mb > 2000)
     return absl::InvalidArgumentError("--max-message-mb must be in 1..2000");
-  if (o.service.threads < 1 || o.service.max_admitted_calls < 1)
+  if (options.service.threads < 1 || options.service.max_admitted_calls < 1)
     return absl::InvalidArgumentError("--threads and --max-calls must be >= 1");
-  auto creds = Credentials(o);
+  for (const std::string& spec : options.fault_inject)
+    if (absl::Status st = ArmFault(spec); !st.ok()) return st;
+  auto creds = Credentials(options);
   if (!creds.ok()) return creds.status();
-  auto metrics = Metrics::Create(o.metrics_listen);
+  auto metrics = Metrics::Create(options.metrics_listen);
   if (!metrics.ok()) return metrics.status();
 
   // Handle SIGTERM/SIGINT on one thread of our own: they are blocked (main
@@ -60,43 +63,43 @@ absl::Status RunServer(const ServerOptions& o) {
   sigaddset(&signals, SIGINT);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
-  InspectionService service(o.service, metrics->get());
+  InspectionService service(options.service, metrics->get());
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
   int port = 0;
-  builder.AddListeningPort(o.listen, *creds, &port);
-  builder.SetMaxReceiveMessageSize(o.max_message_mb << 20);
-  builder.SetMaxSendMessageSize(o.max_message_mb << 20);
-  if (o.max_connection_age_s > 0) {
-    builder.AddChannelArgument(GRPC_ARG_MAX_CONNECTION_AGE_MS, o.max_connection_age_s * 1000);
+  builder.AddListeningPort(options.listen, *creds, &port);
+  builder.SetMaxReceiveMessageSize(options.max_message_mb << 20);
+  builder.SetMaxSendMessageSize(options.max_message_mb << 20);
+  if (options.max_connection_age_s > 0) {
+    builder.AddChannelArgument(GRPC_ARG_MAX_CONNECTION_AGE_MS, options.max_connection_age_s * 1000);
     builder.AddChannelArgument(GRPC_ARG_MAX_CONNECTION_AGE_GRACE_MS, 30000);
   }
   builder.RegisterService(&service);
   std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
   if (!server || port == 0)
-    return absl::UnavailableError(absl::StrCat("cannot listen on ", o.listen));
+    return absl::UnavailableError(absl::StrCat("cannot listen on ", options.listen));
   grpc::HealthCheckServiceInterface* health = server->GetHealthCheckService();
   health->SetServingStatus(true);
   health->SetServingStatus("surfinspect.v1.InspectionService", true);
 
-  const std::string host = o.listen.substr(0, o.listen.rfind(':'));
+  const std::string host = options.listen.substr(0, options.listen.rfind(':'));
   std::printf("surfinspectd listening on %s:%d\n", host.c_str(), port);
   std::fflush(stdout);
   spdlog::info(
       "serving on {}:{} ({} worker threads, {} admitted calls, TLS {}, token {}, metrics {})", host,
-      port, o.service.threads, o.service.max_admitted_calls,
-      o.tls_cert_file.empty() ? "off" : (o.tls_client_ca_file.empty() ? "on" : "mTLS"),
-      o.service.auth_token.empty() ? "off" : "on",
-      o.metrics_listen.empty() ? "off" : o.metrics_listen);
+      port, options.service.threads, options.service.max_admitted_calls,
+      options.tls_cert_file.empty() ? "off" : (options.tls_client_ca_file.empty() ? "on" : "mTLS"),
+      options.service.auth_token.empty() ? "off" : "on",
+      options.metrics_listen.empty() ? "off" : options.metrics_listen);
 
   std::thread waiter([&] {
     int sig = 0;
     sigwait(&signals, &sig);
-    spdlog::info("signal {}: draining (up to {} s)", sig, o.drain_seconds);
+    spdlog::info("signal {}: draining (up to {} s)", sig, options.drain_seconds);
     health->Shutdown();  // NOT_SERVING for everyone, frozen
     server->Shutdown(std::chrono::system_clock::now() +
-                     std::chrono::milliseconds(static_cast<int64_t>(o.drain_seconds * 1000)));
+                     std::chrono::milliseconds(static_cast<int64_t>(options.drain_seconds * 1000)));
   });
   server->Wait();
   waiter.join();

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "server/inspection_service.h"
@@ -22,6 +23,8 @@ struct ServerOptions {
   // Close connections after this age so clients re-resolve and spread over
   // new replicas (HTTP/2 pins every call to one connection). 0 = never.
   int max_connection_age_s = 300;
+  // Test hook (server/fault_hook.h): each KIND:SITE[:COUNT] arms a fault.
+  std::vector<std::string> fault_inject;
 };
 
 // Blocks until a shutdown signal. Prints "surfinspectd listening on

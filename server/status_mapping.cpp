@@ -2,10 +2,10 @@
 
 namespace surfinspect::server {
 
-grpc::Status ToGrpc(const absl::Status& s) {
-  if (s.ok()) return grpc::Status::OK;
+grpc::Status ToGrpc(const absl::Status& status) {
+  if (status.ok()) return grpc::Status::OK;
   grpc::StatusCode code = grpc::StatusCode::INTERNAL;
-  switch (s.code()) {
+  switch (status.code()) {
     case absl::StatusCode::kInvalidArgument:
       code = grpc::StatusCode::INVALID_ARGUMENT;
       break;
@@ -52,7 +52,7 @@ grpc::Status ToGrpc(const absl::Status& s) {
       code = grpc::StatusCode::INTERNAL;
       break;
   }
-  return grpc::Status(code, std::string(s.message()));
+  return grpc::Status(code, std::string(status.message()));
 }
 
 const char* CodeName(grpc::StatusCode code) {

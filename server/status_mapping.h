@@ -1,8 +1,12 @@
-// The one place core statuses become gRPC statuses. Core returns
-// absl::Status; no exception ever crosses an RPC boundary.
+// The one mapping from absl::Status (what core and proto/convert return) to
+// grpc::Status: each absl code becomes the gRPC code of the same name, the
+// message is kept, and an unknown code becomes INTERNAL. Exceptions never
+// reach it: server/guarded.h turns them into statuses at every callback.
 #pragma once
 
 #include <grpcpp/support/status.h>
+
+#include <string>
 
 #include "absl/status/status.h"
 

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "server/guarded.h"
+
 namespace surfinspect::server {
 
 WorkPool::WorkPool(int threads, int max_admitted)
@@ -22,8 +24,8 @@ bool WorkPool::TrySubmit(std::function<void()> job) {
   {
     std::lock_guard<std::mutex> lock(mu_);
     if (stopping_ || admitted_ >= max_admitted_) return false;
+    queue_.push_back(std::move(job));  // first: if it throws, nothing was admitted
     ++admitted_;
-    queue_.push_back(std::move(job));
   }
   cv_.notify_one();
   return true;
@@ -44,7 +46,8 @@ void WorkPool::Worker() {
       job = std::move(queue_.front());
       queue_.pop_front();
     }
-    arena_.execute([&] { job(); });
+    // A job guards its own call; this guard keeps the thread alive if one does not.
+    Guarded("WorkPool", "Worker", [&] { arena_.execute([&] { job(); }); });
     std::lock_guard<std::mutex> lock(mu_);
     --admitted_;
   }

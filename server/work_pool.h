@@ -3,7 +3,8 @@
 // A job that does not fit is refused at once, so the caller can answer
 // RESOURCE_EXHAUSTED instead of queueing without bound (and running out of
 // memory on large clouds). Jobs run inside one shared tbb::task_arena, so the
-// parallel kernels of all calls together use at most `threads` cores.
+// parallel kernels of all calls together use at most `threads` cores. A job
+// that throws is logged and dropped (server/guarded.h); the worker lives on.
 #pragma once
 
 #include <tbb/task_arena.h>
@@ -25,6 +26,7 @@ class WorkPool {
   WorkPool& operator=(const WorkPool&) = delete;
 
   // False (and `job` not run) when max_admitted jobs are already admitted.
+  // If it throws (std::bad_alloc while queueing), `job` is not admitted.
   bool TrySubmit(std::function<void()> job);
   int admitted() const;
 

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <string>
 
 namespace surfinspect::wire {
 namespace {
@@ -66,6 +67,135 @@ TEST(CloudAssembler, OverrunAndInfinityAreInvalidAndNamed) {
   EXPECT_EQ(inf.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_NE(inf.message().find("point 1 has an infinite coordinate"), absl::string_view::npos)
       << inf.message();
+}
+
+std::string Hex(const std::string& bytes) {
+  static const char* digits = "0123456789abcdef";
+  std::string out;
+  for (unsigned char b : bytes) {
+    out += digits[b >> 4];
+    out += digits[b & 15];
+  }
+  return out;
+}
+
+// Little-endian bytes written out by hand; an Unpack inverts its Pack and
+// drops a trailing partial element.
+TEST(PackedArrays, AreLittleEndianAndRoundTrip) {
+  EXPECT_EQ(Hex(PackUint16({1, 0x0203, 0xffff})), "01000302ffff");
+  EXPECT_EQ(Hex(PackUint32({1, 0x01020304u, 70000})), "010000000403020170110100");
+  EXPECT_EQ(Hex(PackFloats({1.0f, -2.5f})), "0000803f000020c0");
+  EXPECT_EQ(UnpackUint16(std::string("\x01\x00\x03\x02\xff", 5)),
+            (std::vector<uint16_t>{1, 0x0203}));
+  EXPECT_EQ(UnpackUint32(PackUint32({7, 0xdeadbeefu})), (std::vector<uint32_t>{7, 0xdeadbeefu}));
+  EXPECT_EQ(UnpackFloats(PackFloats({0.5f, 3.25f})), (std::vector<float>{0.5f, 3.25f}));
+  EXPECT_TRUE(UnpackUint16("").empty());
+  EXPECT_EQ(PackUint32({}), "");
+}
+
+TEST(FilterResultToProto, CloudStatsAndOneMaskBytePerPoint) {
+  const PointCloud filtered = Grid(2, 2);
+  LinkClusteringResult r;
+  r.kept_mask = {1, 0, 0, 1};
+  r.input_points = 4;
+  r.valid_points = 3;
+  r.kept = 2;
+  r.removed = 1;
+  r.largest_cluster = 2;
+  r.clusters.resize(2);
+  r.clusters[0].kept = true;
+  v1::FilterResponse msg;
+  FilterResultToProto(filtered, r, &msg);
+  EXPECT_EQ(msg.kept_mask(), std::string("\x01\x00\x00\x01", 4));
+  EXPECT_EQ(msg.stats().valid_points(), 3u);
+  EXPECT_EQ(msg.stats().kept(), 2u);
+  EXPECT_EQ(msg.stats().removed(), 1u);
+  EXPECT_EQ(msg.stats().clusters(), 2u);
+  EXPECT_EQ(msg.stats().removed_clusters(), 1u);
+  EXPECT_EQ(msg.cloud().width(), 2u);
+  EXPECT_EQ(msg.cloud().xyz(), Bytes(filtered));
+}
+
+TEST(MergedCloudToProto, PacksViewAndGridIndicesPerPoint) {
+  MergedCloud m;
+  m.cloud_in_world = PointCloud::Unorganized({{1, 2, 3}, {4, 5, 6}, {7, 8, 9}});
+  m.view_id = {0, 1, 1};
+  m.grid_index = {5, 0, 70000};
+  m.view_names = {"v1", "v2"};
+  m.points_per_view = {1, 2};
+  v1::RegisterResponse msg;
+  MergedCloudToProto(m, &msg);
+  EXPECT_EQ(Hex(msg.view_index()), "000001000100");
+  EXPECT_EQ(Hex(msg.grid_index()), "050000000000000070110100");
+  EXPECT_EQ(UnpackUint16(msg.view_index()), m.view_id);
+  EXPECT_EQ(UnpackUint32(msg.grid_index()), m.grid_index);
+  ASSERT_EQ(msg.points_per_view_size(), 2);
+  EXPECT_EQ(msg.points_per_view(0), 1u);
+  EXPECT_EQ(msg.points_per_view(1), 2u);
+  auto merged = CloudFromProto(msg.merged(), "merged", Limits{});
+  ASSERT_TRUE(merged.ok()) << merged.status();
+  EXPECT_EQ(Bytes(*merged), Bytes(m.cloud_in_world));
+  EXPECT_FALSE(msg.has_best_fit_correction()) << "the caller's";
+}
+
+ErrorMapResult SmallMap(bool pass) {
+  ErrorMapResult map;
+  map.deviation_mm = {0.01f, NAN, -0.02f};
+  map.stats.count = 3;
+  map.stats.valid = 3;
+  map.stats.matched = 2;
+  map.verdict.pass = pass;
+  map.verdict.reason = pass ? "all within" : "too many outside";
+  map.tolerance_mm = 0.1;
+  return map;
+}
+
+TEST(ErrorMapToProto, ReportVerdictAndDeviationsOnlyWhenAsked) {
+  const ErrorMapSettings settings;
+  v1::ErrorMapResponse with;
+  ErrorMapToProto(SmallMap(true), settings, true, &with);
+  EXPECT_EQ(with.verdict(), "pass");
+  EXPECT_EQ(with.report_json(), ErrorMapReportText(SmallMap(true), settings));
+  EXPECT_EQ(with.deviations(), PackFloats(SmallMap(true).deviation_mm));
+  v1::ErrorMapResponse without;
+  ErrorMapToProto(SmallMap(false), settings, false, &without);
+  EXPECT_EQ(without.verdict(), "fail");
+  EXPECT_TRUE(without.deviations().empty());
+  EXPECT_TRUE(without.png().empty()) << "the caller's";
+}
+
+TEST(InspectionResultToProto, PartIdVerdictReportViewsAndOptionalDeviations) {
+  InspectionResult r;
+  r.error_map = SmallMap(false);
+  r.merged.cloud_in_world = PointCloud::Unorganized({{1, 2, 3}, {4, 5, 6}, {7, 8, 9}});
+  r.views = {{"top", 1200, 7}, {"side", 800, 0}};
+  ErrorMapSettings settings;
+  settings.tolerance_mm = 0.25;
+  v1::InspectResult msg;
+  InspectionResultToProto("part-7", r, settings, true, &msg);
+  EXPECT_EQ(msg.part_id(), "part-7");
+  EXPECT_EQ(msg.verdict(), "fail");
+  EXPECT_EQ(msg.report_json(), ErrorMapReportText(r.error_map, settings));
+  ASSERT_EQ(msg.views_size(), 2);
+  EXPECT_EQ(msg.views(0).name(), "top");
+  EXPECT_EQ(msg.views(0).valid_points(), 1200u);
+  EXPECT_EQ(msg.views(0).removed_points(), 7u);
+  EXPECT_EQ(msg.views(1).name(), "side");
+  EXPECT_EQ(msg.views(1).valid_points(), 800u);
+  EXPECT_EQ(msg.deviations(), PackFloats(r.error_map.deviation_mm));
+  EXPECT_EQ(msg.merged().xyz(), Bytes(r.merged.cloud_in_world));
+
+  v1::InspectResult lean;
+  InspectionResultToProto("part-7", r, settings, false, &lean);
+  EXPECT_TRUE(lean.deviations().empty());
+  EXPECT_FALSE(lean.has_merged());
+  EXPECT_EQ(lean.views_size(), 2);
+}
+
+TEST(StageToProto, EveryCoreStageHasItsWireStage) {
+  EXPECT_EQ(StageToProto(InspectionStage::kViewFiltered), v1::Progress::STAGE_VIEW_FILTERED);
+  EXPECT_EQ(StageToProto(InspectionStage::kViewRegistered), v1::Progress::STAGE_VIEW_REGISTERED);
+  EXPECT_EQ(StageToProto(InspectionStage::kErrorMap), v1::Progress::STAGE_ERROR_MAP);
 }
 
 }  // namespace

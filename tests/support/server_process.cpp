@@ -51,6 +51,8 @@ ServerProcess::ServerProcess(const std::vector<std::string>& extra) {
     const ssize_t r = ::read(out[0], buf, sizeof(buf));
     if (r > 0)
       line.append(buf, static_cast<std::size_t>(r));
+    else if (r == 0)
+      break;  // the server exited (e.g. a bad flag) without listening
     else
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
