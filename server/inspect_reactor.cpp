@@ -116,6 +116,15 @@ grpc::Status InspectReactor::ConsumeView(const v1::ViewHeader& view) {
   if (!pose.ok()) return ToGrpc(pose.status());
   ViewScan scan;
   scan.name = view.name().empty() ? absl::StrCat("view", views_.size()) : view.name();
+  // Before a byte of the view is buffered: a part that does not fit is
+  // refused now, while the client still holds its data to send again.
+  const uint64_t view_points = uint64_t{view.width()} * view.height();
+  if (grpc::Status room =
+          service_->Reserve(view_points * InspectBytesPerPoint(),
+                            absl::StrCat("Inspect part '", part_.id, "' view '", scan.name, "'"),
+                            &reserved_.emplace_back());
+      !room.ok())
+    return room;
   scan.world_from_sensor = *pose;
   views_.push_back(std::move(scan));
   view_cloud_.Start(view.width(), view.height());

@@ -73,6 +73,8 @@ class InspectReactor final
   void MaybeFinishLocked();
   void LogAndCountLocked();
 
+  // First members, so they are released last: after the views' clouds.
+  std::vector<MemoryBudget::Reservation> reserved_;
   InspectionService* service_;
   grpc::CallbackServerContext* ctx_;
   std::string request_id_;

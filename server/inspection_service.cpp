@@ -52,6 +52,10 @@ class HeavyCall final : public grpc::ServerUnaryReactor {
   // exception before it leaves nothing running.
   grpc::Status Admit() {
     if (grpc::Status auth = service_->Authorize(ctx_); !auth.ok()) return auth;
+    if (grpc::Status room =
+            service_->Reserve(points_ * UnaryCloudBytesPerPoint(), method_, &reservation_);
+        !room.ok())
+      return room;
     service_->metrics()->CallStarted();
     admitted_ = true;
     if (!service_->pool().TrySubmit([this] { Run(); }))
@@ -81,6 +85,8 @@ class HeavyCall final : public grpc::ServerUnaryReactor {
     if (st.ok()) service_->metrics()->AddPoints(points_);
   }
 
+  // First member, so it is released last: after the call's own data.
+  MemoryBudget::Reservation reservation_;
   InspectionService* service_;
   grpc::CallbackServerContext* ctx_;
   const char* method_;
@@ -100,9 +106,23 @@ InspectionService::InspectionService(ServiceConfig config, Metrics* metrics)
     : config_(std::move(config)),
       metrics_(metrics),
       mesh_cache_(config_.mesh_cache_bytes),
-      pool_(config_.threads, config_.max_admitted_calls) {}
+      budget_(config_.memory_budget_bytes != 0 ? config_.memory_budget_bytes : UINT64_MAX),
+      pool_(config_.threads, config_.max_admitted_calls) {
+  metrics_->SetMemoryBudget(budget_.budget_bytes());
+  budget_.SetObserver([metrics = metrics_](uint64_t reserved, uint64_t refused) {
+    metrics->SetMemoryReserved(reserved, refused);
+  });
+}
 
 InspectionService::~InspectionService() = default;
+
+grpc::Status InspectionService::Reserve(uint64_t bytes, const std::string& what,
+                                        MemoryBudget::Reservation* reservation) {
+  auto r = budget_.TryReserve(bytes, what);
+  if (!r.ok()) return ToGrpc(r.status());
+  *reservation = *std::move(r);
+  return grpc::Status::OK;
+}
 
 grpc::Status InspectionService::Authorize(const grpc::CallbackServerContext* ctx) const {
   if (config_.auth_token.empty()) return grpc::Status::OK;

@@ -17,6 +17,7 @@
 #include <string>
 
 #include "proto/convert.h"
+#include "server/memory_budget.h"
 #include "server/mesh_cache.h"
 #include "server/metrics.h"
 #include "server/work_pool.h"
@@ -29,6 +30,9 @@ struct ServiceConfig {
   int threads = 2;              // worker threads = cores used by heavy calls
   int max_admitted_calls = 16;  // running + queued; more -> RESOURCE_EXHAUSTED
   std::size_t mesh_cache_bytes = std::size_t{512} << 20;
+  // Bytes the calls may reserve at once (server/memory_budget.h); 0 = no
+  // limit. RunServer fills in the default from the machine's limits.
+  uint64_t memory_budget_bytes = 0;
   std::string auth_token;  // empty = no bearer-token check
   bool json_logs = false;
 };
@@ -55,6 +59,10 @@ class InspectionService final : public v1::InspectionService::CallbackService {
   // ---- shared by the reactors ----
   const ServiceConfig& config() const { return config_; }
   WorkPool& pool() { return pool_; }
+  // Reserves what a call will hold, or RESOURCE_EXHAUSTED (with a retry
+  // hint in the message) before the call buffers it.
+  grpc::Status Reserve(uint64_t bytes, const std::string& what,
+                       MemoryBudget::Reservation* reservation);
   Metrics* metrics() { return metrics_; }
   // UNAUTHENTICATED unless the call carries "authorization: Bearer <token>"
   // (when a token is configured).
@@ -78,6 +86,7 @@ class InspectionService final : public v1::InspectionService::CallbackService {
   ServiceConfig config_;
   Metrics* metrics_;
   MeshCache mesh_cache_;
+  MemoryBudget budget_;
   std::atomic<uint64_t> next_request_{1};
   WorkPool pool_;  // last: joined first on destruction, before the cache goes
 };

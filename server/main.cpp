@@ -42,6 +42,11 @@ void AddFlags(CLI::App& app, ServerOptions& o, std::string& token_file, uint64_t
   app.add_option("--max-message-mb", o.max_message_mb, "largest gRPC message, MiB")
       ->envname("SURFINSPECT_MAX_MESSAGE_MB")
       ->capture_default_str();
+  app.add_option("--max-memory-mb", o.max_memory_mb,
+                 "memory the calls may hold at once, MiB; a call that does not fit gets "
+                 "RESOURCE_EXHAUSTED before its data is buffered (default: 3/4 of the cgroup "
+                 "limit or physical memory, at most 1/2 of ulimit -v)")
+      ->envname("SURFINSPECT_MAX_MEMORY_MB");
   app.add_option("--mesh-cache-mb", mesh_cache_mb, "mesh index cache budget, MiB")
       ->envname("SURFINSPECT_MESH_CACHE_MB")
       ->capture_default_str();

@@ -54,25 +54,36 @@ void MemoryBudget::Reservation::Release() {
   bytes_ = 0;
 }
 
+void MemoryBudget::Return(uint64_t bytes) {
+  const uint64_t now = reserved_.fetch_sub(bytes, std::memory_order_relaxed) - bytes;
+  if (observer_) observer_(now, 0);
+}
+
+absl::Status MemoryBudget::Refuse(uint64_t bytes, std::string message) {
+  refused_.fetch_add(bytes, std::memory_order_relaxed);
+  if (observer_) observer_(reserved_bytes(), bytes);
+  return absl::ResourceExhaustedError(std::move(message));
+}
+
 absl::StatusOr<MemoryBudget::Reservation> MemoryBudget::TryReserve(uint64_t bytes,
                                                                    const std::string& what) {
-  if (bytes > budget_) {
-    refused_.fetch_add(bytes, std::memory_order_relaxed);
-    return absl::ResourceExhaustedError(absl::StrFormat(
-        "%s needs %.0f MiB, more than the server's whole memory budget of %.0f MiB; "
-        "send a smaller request or raise --max-memory-mb",
-        what, bytes / kMiB, budget_ / kMiB));
-  }
+  if (bytes > budget_)
+    return Refuse(bytes,
+                  absl::StrFormat(
+                      "%s needs %.0f MiB, more than the server's whole memory budget of %.0f MiB; "
+                      "send a smaller request or raise --max-memory-mb",
+                      what, bytes / kMiB, budget_ / kMiB));
   uint64_t held = reserved_.load(std::memory_order_relaxed);
   do {
-    if (held + bytes > budget_) {
-      refused_.fetch_add(bytes, std::memory_order_relaxed);
-      return absl::ResourceExhaustedError(absl::StrFormat(
-          "%s needs %.0f MiB and %.0f MiB of the %.0f MiB memory budget are held by other "
-          "calls; retry later",
-          what, bytes / kMiB, held / kMiB, budget_ / kMiB));
-    }
+    if (held + bytes > budget_)
+      return Refuse(
+          bytes,
+          absl::StrFormat(
+              "%s needs %.0f MiB and %.0f MiB of the %.0f MiB memory budget are held by other "
+              "calls; retry later",
+              what, bytes / kMiB, held / kMiB, budget_ / kMiB));
   } while (!reserved_.compare_exchange_weak(held, held + bytes, std::memory_order_relaxed));
+  if (observer_) observer_(held + bytes, 0);
   return Reservation(this, bytes);
 }
 

@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include "absl/status/statusor.h"
@@ -37,6 +38,11 @@ class MemoryBudget {
 
   explicit MemoryBudget(uint64_t budget_bytes) : budget_(budget_bytes) {}
 
+  // Called after every reservation, release and refusal with the reserved
+  // total and the bytes just refused (0 unless refused); for the metrics.
+  using Observer = std::function<void(uint64_t reserved_bytes, uint64_t refused_bytes)>;
+  void SetObserver(Observer observer) { observer_ = std::move(observer); }
+
   // Reserves `bytes` for `what` (named in the refusal), or RESOURCE_EXHAUSTED
   // when the reserved total would pass the budget: "retry later" when other
   // calls hold the room, "never fits" when `bytes` alone exceeds the budget.
@@ -48,8 +54,10 @@ class MemoryBudget {
   uint64_t refused_bytes() const { return refused_.load(std::memory_order_relaxed); }
 
  private:
-  void Return(uint64_t bytes) { reserved_.fetch_sub(bytes, std::memory_order_relaxed); }
+  void Return(uint64_t bytes);
+  absl::Status Refuse(uint64_t bytes, std::string message);
   const uint64_t budget_;
+  Observer observer_;
   std::atomic<uint64_t> reserved_{0};
   std::atomic<uint64_t> refused_{0};
 };

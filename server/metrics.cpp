@@ -38,6 +38,21 @@ absl::StatusOr<std::unique_ptr<Metrics>> Metrics::Create(const std::string& list
                        .Help("Heavy calls admitted and not yet finished")
                        .Register(*m->registry_)
                        .Add({});
+  m->memory_budget_ = &prometheus::BuildGauge()
+                           .Name("surfinspect_memory_budget_bytes")
+                           .Help("Bytes the calls may reserve at once (--max-memory-mb)")
+                           .Register(*m->registry_)
+                           .Add({});
+  m->memory_reserved_ = &prometheus::BuildGauge()
+                             .Name("surfinspect_memory_reserved_bytes")
+                             .Help("Bytes reserved by the calls in progress")
+                             .Register(*m->registry_)
+                             .Add({});
+  m->memory_refused_ = &prometheus::BuildCounter()
+                            .Name("surfinspect_memory_refused_bytes_total")
+                            .Help("Bytes of calls refused with RESOURCE_EXHAUSTED for the budget")
+                            .Register(*m->registry_)
+                            .Add({});
   if (!listen.empty()) {
     try {
       m->exposer_ = std::make_unique<prometheus::Exposer>(listen, 1);
@@ -66,6 +81,11 @@ void Metrics::MeshCacheHit() { cache_hits_->Increment(); }
 void Metrics::MeshCacheMiss() { cache_misses_->Increment(); }
 void Metrics::CallStarted() { in_flight_->Increment(); }
 void Metrics::CallEnded() { in_flight_->Decrement(); }
+void Metrics::SetMemoryBudget(uint64_t bytes) { memory_budget_->Set(double(bytes)); }
+void Metrics::SetMemoryReserved(uint64_t reserved_bytes, uint64_t refused_bytes) {
+  memory_reserved_->Set(double(reserved_bytes));
+  if (refused_bytes != 0) memory_refused_->Increment(double(refused_bytes));
+}
 
 std::string Metrics::Scrape() const {
   return prometheus::TextSerializer().Serialize(registry_->Collect());

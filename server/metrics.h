@@ -32,6 +32,10 @@ class Metrics {
   void MeshCacheMiss();
   void CallStarted();
   void CallEnded();
+  // The memory budget (server/memory_budget.h): its size, what calls hold
+  // now, and bytes refused (added to a counter).
+  void SetMemoryBudget(uint64_t bytes);
+  void SetMemoryReserved(uint64_t reserved_bytes, uint64_t refused_bytes);
   // The text exposition, for tests and for `--metrics-listen` off.
   std::string Scrape() const;
 
@@ -45,6 +49,9 @@ class Metrics {
   prometheus::Counter* cache_hits_ = nullptr;
   prometheus::Counter* cache_misses_ = nullptr;
   prometheus::Gauge* in_flight_ = nullptr;
+  prometheus::Gauge* memory_budget_ = nullptr;
+  prometheus::Gauge* memory_reserved_ = nullptr;
+  prometheus::Counter* memory_refused_ = nullptr;
 };
 
 }  // namespace surfinspect::server

@@ -6,6 +6,7 @@
 #include <signal.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <thread>
@@ -13,6 +14,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/io/atomic_file.h"
 #include "server/fault_hook.h"
+#include "server/memory_budget.h"
 
 namespace surfinspect::server {
 namespace {
@@ -40,11 +42,24 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> Credentials(const Serve
   return grpc::SslServerCredentials(ssl);
 }
 
+// --max-memory-mb, or the default from the machine's limits (logged).
+uint64_t MemoryBudgetBytes(const ServerOptions& options) {
+  if (options.max_memory_mb != 0) return options.max_memory_mb << 20;
+  const MemoryLimits m = DetectMemoryLimits();
+  spdlog::info(
+      "memory budget {} MiB from the {} (physical {} MiB, cgroup {} MiB, RLIMIT_AS {} MiB)",
+      m.default_budget_bytes >> 20, m.source, m.physical_bytes >> 20, m.cgroup_bytes >> 20,
+      m.address_space_bytes >> 20);
+  return m.default_budget_bytes;
+}
+
 }  // namespace
 
 absl::Status RunServer(const ServerOptions& options) {
   if (options.max_message_mb < 1 || options.max_message_mb > 2000)
     return absl::InvalidArgumentError("--max-message-mb must be in 1..2000");
+  if (options.max_memory_mb > (uint64_t{1} << 24))
+    return absl::InvalidArgumentError("--max-memory-mb must be at most 16777216 (16 TiB)");
   if (options.service.threads < 1 || options.service.max_admitted_calls < 1)
     return absl::InvalidArgumentError("--threads and --max-calls must be >= 1");
   for (const std::string& spec : options.fault_inject)
@@ -63,7 +78,9 @@ absl::Status RunServer(const ServerOptions& options) {
   sigaddset(&signals, SIGINT);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
-  InspectionService service(options.service, metrics->get());
+  ServiceConfig config = options.service;
+  config.memory_budget_bytes = MemoryBudgetBytes(options);
+  InspectionService service(config, metrics->get());
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
@@ -71,6 +88,13 @@ absl::Status RunServer(const ServerOptions& options) {
   builder.AddListeningPort(options.listen, *creds, &port);
   builder.SetMaxReceiveMessageSize(options.max_message_mb << 20);
   builder.SetMaxSendMessageSize(options.max_message_mb << 20);
+  // gRPC's own buffers (messages being received or sent) get a quarter of
+  // the budget on top of it; past that gRPC stops reading from clients
+  // instead of allocating.
+  grpc::ResourceQuota quota("surfinspectd");
+  quota.Resize(static_cast<std::size_t>(
+      std::max<uint64_t>(config.memory_budget_bytes / 4, uint64_t(options.max_message_mb) << 21)));
+  builder.SetResourceQuota(quota);
   if (options.max_connection_age_s > 0) {
     builder.AddChannelArgument(GRPC_ARG_MAX_CONNECTION_AGE_MS, options.max_connection_age_s * 1000);
     builder.AddChannelArgument(GRPC_ARG_MAX_CONNECTION_AGE_GRACE_MS, 30000);
@@ -87,8 +111,10 @@ absl::Status RunServer(const ServerOptions& options) {
   std::printf("surfinspectd listening on %s:%d\n", host.c_str(), port);
   std::fflush(stdout);
   spdlog::info(
-      "serving on {}:{} ({} worker threads, {} admitted calls, TLS {}, token {}, metrics {})", host,
-      port, options.service.threads, options.service.max_admitted_calls,
+      "serving on {}:{} ({} worker threads, {} admitted calls, memory budget {} MiB, TLS {}, "
+      "token {}, metrics {})",
+      host, port, options.service.threads, options.service.max_admitted_calls,
+      config.memory_budget_bytes >> 20,
       options.tls_cert_file.empty() ? "off" : (options.tls_client_ca_file.empty() ? "on" : "mTLS"),
       options.service.auth_token.empty() ? "off" : "on",
       options.metrics_listen.empty() ? "off" : options.metrics_listen);

@@ -19,7 +19,10 @@ struct ServerOptions {
   std::string tls_cert_file, tls_key_file;  // both set = TLS
   std::string tls_client_ca_file;           // set = mTLS (client certificates required)
   int max_message_mb = 64;                  // per message, both directions
-  double drain_seconds = 20;                // graceful-shutdown deadline
+  // What the calls may hold at once, MiB (server/memory_budget.h); 0 = the
+  // default from the cgroup limit, physical memory and RLIMIT_AS.
+  uint64_t max_memory_mb = 0;
+  double drain_seconds = 20;  // graceful-shutdown deadline
   // Close connections after this age so clients re-resolve and spread over
   // new replicas (HTTP/2 pins every call to one connection). 0 = never.
   int max_connection_age_s = 300;
