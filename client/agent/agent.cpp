@@ -220,7 +220,7 @@ RunSummary CellAgent::Run(const std::atomic<bool>& stop,
       }
     }
     if (settings_.once && (!progressed || CompleteParts(layout_.inbox).empty())) break;
-    if (!progressed) hooks_.sleep(settings_.poll_s, stop);
+    if (!progressed && !stop.load()) hooks_.sleep(settings_.poll_s, stop);
   }
   return s;
 }

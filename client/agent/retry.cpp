@@ -8,12 +8,15 @@
 namespace surfinspect::client {
 
 void SleepUnlessStopped(double seconds, const std::atomic<bool>& stop) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point end =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                         std::chrono::duration<double>(std::max(0.0, seconds)));
   while (!stop.load()) {
-    const auto now = std::chrono::steady_clock::now();
+    const Clock::time_point now = Clock::now();
     if (now >= end) return;
     std::this_thread::sleep_for(
-        std::min<std::chrono::steady_clock::duration>(end - now, std::chrono::milliseconds(50)));
+        std::min<Clock::duration>(end - now, std::chrono::milliseconds(50)));
   }
 }
 

@@ -73,7 +73,8 @@ void Calibrate(const CalibrateArgs& a) {
       Take(wire::TransformFromProto(resp.world_from_sensor(), "world_from_sensor"));
   Check(WriteTransformJson(a.out, world_from_sensor));
   if (!a.report.empty())
-    Check(WriteStringAtomically(a.report, CalibrationQualityJson(resp.quality()).dump(2) + "\n"));
+    Check(WriteStringAtomically(a.report,
+                                client::CalibrationQualityJson(resp.quality()).dump(2) + "\n"));
   std::printf("%s\n", CalibrationLine("viewpoint", resp).c_str());
   for (const auto& w : resp.quality().warnings()) spdlog::warn("{}", w);
 }

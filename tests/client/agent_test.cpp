@@ -44,7 +44,8 @@ class AgentTest : public ::testing::Test {
     cell_.viewpoints.push_back(vp);
     hooks_.sleep = [this](double s, const std::atomic<bool>&) {
       sleeps_.push_back(s);
-      if (stop_in_sleep_) stop_.store(true);
+      // A loop that never ends a test is a failure, not a hang.
+      if (stop_in_sleep_ || sleeps_.size() >= 100) stop_.store(true);
     };
     hooks_.inspect = [this](const v1::PartHeader& header, const std::vector<ViewScan>& views) {
       EXPECT_EQ(views.size(), 1u);
@@ -182,7 +183,8 @@ TEST_F(AgentTest, ArchiveNameCollisionKeepsBothParts) {
 TEST_F(AgentTest, FailedQuarantineIsReportedRetriedLaterAndNeverResent) {
   WriteBytes(layout_.quarantine, "a file where the quarantine folder should be");
   DropPart("p1");
-  answers_ = {absl::InvalidArgumentError("bad settings")};
+  // The same verdict however often it is asked.
+  answers_.assign(8, absl::InvalidArgumentError("bad settings"));
   CellAgent agent = Agent();
   const PartReport first = agent.ProcessPart("p1", stop_);
   EXPECT_EQ(first.outcome, PartOutcome::kRetryLater);
@@ -240,11 +242,15 @@ TEST_F(AgentTest, CorruptScanIsQuarantinedWithoutACall) {
   DropPart("p1");
   const std::string scan = (fs::path(layout_.inbox) / "p1" / "v1.pcd").string();
   const std::string bytes = ReadBytes(scan);
-  WriteBytes(scan, bytes.substr(0, bytes.size() / 2));
+  // Keep the header and the first of the three points (PCL pads the file).
+  const std::size_t data = bytes.find("DATA binary\n");
+  ASSERT_NE(data, std::string::npos);
+  WriteBytes(scan, bytes.substr(0, data + 12 + 12));
   CellAgent agent = Agent();
   const PartReport r = agent.ProcessPart("p1", stop_);
   EXPECT_EQ(r.outcome, PartOutcome::kQuarantined);
   EXPECT_EQ(calls_, 0);
+  EXPECT_NE(r.message.find("truncated"), std::string::npos) << r.message;
   EXPECT_EQ(ReadBytes((fs::path(layout_.quarantine) / "p1" / "error.txt").string()),
             r.message + "\n");
 }
