@@ -3,8 +3,7 @@
 // CalibrateResponse and so write the same bytes.
 #include <spdlog/spdlog.h>
 
-#include <nlohmann/json.hpp>
-
+#include "client/cell/calibration_quality.h"
 #include "client/cli/commands.h"
 #include "client/cli/remote_args.h"
 #include "core/io/atomic_file.h"
@@ -24,30 +23,7 @@ struct CalibrateArgs {
   RemoteArgs remote;
 };
 
-nlohmann::json QualityJson(const v1::CalibrateResponse& r) {
-  const v1::CalibrationQuality& q = r.quality();
-  return {
-      {"rms", q.rms_mm()},
-      {"iterations", q.iterations()},
-      {"converged", q.converged()},
-      {"stop_reason", q.stop_reason()},
-      {"inlier_fraction", q.inlier_fraction()},
-      {"sigma_translation_um", q.sigma_translation_um()},
-      {"sigma_rotation_deg", q.sigma_rotation_deg()},
-      {"degenerate", q.degenerate()},
-      {"degeneracy_ratio", q.degeneracy_ratio()},
-      {"residual_p50_mm", q.residual_p50_mm()},
-      {"residual_p95_mm", q.residual_p95_mm()},
-      {"residual_p99_mm", q.residual_p99_mm()},
-      {"filtered_points", q.filtered_points()},
-      {"cost_history_mm2", std::vector<double>(q.cost_history().begin(), q.cost_history().end())},
-      {"warnings", std::vector<std::string>(q.warnings().begin(), q.warnings().end())},
-      {"units", "mm"}};
-}
-
-}  // namespace
-
-// Shared with the cell-agent's table: one line per viewpoint.
+// The one-line summary printed after a calibration.
 std::string CalibrationLine(const std::string& name, const v1::CalibrateResponse& r) {
   const v1::CalibrationQuality& q = r.quality();
   char buf[256];
@@ -57,6 +33,8 @@ std::string CalibrationLine(const std::string& name, const v1::CalibrateResponse
                 q.degenerate() ? "  DEGENERATE" : "");
   return buf;
 }
+
+}  // namespace
 
 void Calibrate(const CalibrateArgs& a) {
   if (a.point_to_point && a.point_to_plane)
@@ -94,7 +72,9 @@ void Calibrate(const CalibrateArgs& a) {
   const Eigen::Isometry3d world_from_sensor =
       Take(wire::TransformFromProto(resp.world_from_sensor(), "world_from_sensor"));
   Check(WriteTransformJson(a.out, world_from_sensor));
-  if (!a.report.empty()) Check(WriteStringAtomically(a.report, QualityJson(resp).dump(2) + "\n"));
+  if (!a.report.empty())
+    Check(WriteStringAtomically(a.report,
+                                client::CalibrationQualityJson(resp.quality()).dump(2) + "\n"));
   std::printf("%s\n", CalibrationLine("viewpoint", resp).c_str());
   for (const auto& w : resp.quality().warnings()) spdlog::warn("{}", w);
 }

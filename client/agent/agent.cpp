@@ -1,0 +1,228 @@
+#include "client/agent/agent.h"
+
+#include <chrono>
+#include <filesystem>
+
+#include "absl/strings/str_cat.h"
+#include "client/cell/part_outputs.h"
+#include "core/io/io_point_cloud.h"
+
+namespace surfinspect::client {
+namespace fs = std::filesystem;
+namespace {
+
+// The folder that holds `inbox` (absolute; a trailing separator ignored).
+fs::path BesideInbox(const std::string& inbox, const char* name) {
+  std::error_code ec;
+  fs::path p = fs::absolute(fs::path(inbox), ec);
+  if (ec) p = fs::path(inbox);
+  p = p.lexically_normal();
+  if (p.filename().empty()) p = p.parent_path();
+  return p.parent_path() / name;
+}
+
+PartReport Report(PartOutcome outcome, std::string message) {
+  PartReport r;
+  r.outcome = outcome;
+  r.message = std::move(message);
+  return r;
+}
+
+}  // namespace
+
+InboxLayout ResolveLayout(const AgentPaths& p) {
+  const auto below = [&](const std::string& given, const char* name, const std::string& dflt) {
+    if (!given.empty()) return given;
+    if (!p.cell_dir.empty()) return (fs::path(p.cell_dir) / name).string();
+    return dflt;
+  };
+  InboxLayout l;
+  l.inbox = below(p.inbox, "inbox", "inbox");
+  l.results = below(p.results, "results", "results");
+  l.archive = below(p.archive, "archive", BesideInbox(l.inbox, "archive").string());
+  l.quarantine = below(p.quarantine, "quarantine", BesideInbox(l.inbox, "quarantine").string());
+  return l;
+}
+
+absl::Status PrepareDirectories(const InboxLayout& layout) {
+  for (const auto& d : {layout.inbox, layout.results}) {
+    std::error_code ec;
+    fs::create_directories(d, ec);
+    if (ec)
+      return absl::PermissionDeniedError(absl::StrCat("cannot create ", d, ": ", ec.message()));
+  }
+  return absl::OkStatus();
+}
+
+const char* PartOutcomeName(PartOutcome outcome) {
+  switch (outcome) {
+    case PartOutcome::kDone:
+      return "done";
+    case PartOutcome::kArchivedWithoutCall:
+      return "archived without call";
+    case PartOutcome::kQuarantined:
+      return "quarantined";
+    case PartOutcome::kRetryLater:
+      return "retry later";
+    case PartOutcome::kStopped:
+      return "stopped";
+    case PartOutcome::kConfigError:
+      return "config error";
+  }
+  return "?";
+}
+
+CellAgent::CellAgent(const CellConfig& cell, InboxLayout layout, AgentSettings settings,
+                     AgentHooks hooks, uint64_t seed)
+    : cell_(cell),
+      layout_(std::move(layout)),
+      settings_(settings),
+      hooks_(std::move(hooks)),
+      rng_(seed) {}
+
+PartReport CellAgent::ProcessPart(const std::string& part_id, const std::atomic<bool>& stop) {
+  const auto t0 = std::chrono::steady_clock::now();
+  PartReport r = Steps(part_id, stop);
+  r.part_id = part_id;
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+PartReport CellAgent::Steps(const std::string& id, const std::atomic<bool>& stop) {
+  if (!IsValidPartId(id)) return QuarantinePart(id, "invalid part id (use letters, digits, . _ -)");
+  // Judged before and the move failed: move again, never send again.
+  if (auto it = quarantine_pending_.find(id); it != quarantine_pending_.end())
+    return QuarantinePart(id, it->second);
+  if (HasResults(layout_, id)) return ArchiveWithoutCall(id);  // never send twice
+  std::vector<ViewScan> views;
+  PartReport ended;
+  if (!ReadViews(id, &views, &ended)) return ended;
+  return InspectAndStore(id, views, stop);
+}
+
+PartReport CellAgent::QuarantinePart(const std::string& id, const std::string& why) {
+  if (absl::Status st = Quarantine(layout_, id, why); !st.ok()) {
+    quarantine_pending_[id] = why;
+    return Report(PartOutcome::kRetryLater,
+                  absl::StrCat("cannot quarantine (", why, "): ", st.message()));
+  }
+  quarantine_pending_.erase(id);
+  return Report(PartOutcome::kQuarantined, why);
+}
+
+PartReport CellAgent::ArchiveWithoutCall(const std::string& id) {
+  if (absl::Status st = MovePart(layout_.inbox, layout_.archive, id); !st.ok())
+    return Report(PartOutcome::kRetryLater,
+                  absl::StrCat("results already on disk; ", st.message()));
+  return Report(PartOutcome::kArchivedWithoutCall, "results already on disk; archived");
+}
+
+bool CellAgent::ReadViews(const std::string& id, std::vector<ViewScan>* views, PartReport* report) {
+  for (const auto& vp : cell_.viewpoints) {
+    const std::string path = (fs::path(layout_.inbox) / id / (vp.name + ".pcd")).string();
+    if (!fs::exists(path)) continue;
+    auto cloud = ReadPointCloud(path);
+    if (!cloud.ok()) {
+      *report = QuarantinePart(id, std::string(cloud.status().message()));
+      return false;
+    }
+    if (!vp.world_from_sensor) {
+      *report = Report(
+          PartOutcome::kConfigError,
+          absl::StrCat("viewpoint ", vp.name, " is not calibrated; run cell-agent calibrate"));
+      return false;
+    }
+    views->push_back({vp.name, *std::move(cloud), *vp.world_from_sensor});
+  }
+  if (views->empty()) {
+    *report = QuarantinePart(id, "no <viewpoint>.pcd scan of this cell's viewpoints");
+    return false;
+  }
+  return true;
+}
+
+PartReport CellAgent::InspectAndStore(const std::string& id, const std::vector<ViewScan>& views,
+                                      const std::atomic<bool>& stop) {
+  const v1::PartHeader header =
+      MakePartHeader(id, cell_.world_from_part, InspectionSettingsOf(cell_));
+  absl::StatusOr<v1::InspectResult> result = absl::UnknownError("not sent");
+  RetryHooks retry{hooks_.sleep, {}};
+  if (hooks_.on_retry)
+    retry.on_retry = [&](const absl::Status& st, int calls, double wait_s) {
+      hooks_.on_retry(id, st, calls, wait_s);
+    };
+  const RetryResult rr = RetryWithBackoff(
+      [&] {
+        result = hooks_.inspect(header, views);
+        return result.status();
+      },
+      IsRetryable, settings_.backoff, retry, rng_, stop);
+  PartReport r;
+  if (rr.end == RetryEnd::kStopped) {
+    r = Report(PartOutcome::kStopped, "stop requested; left in the inbox");
+  } else if (rr.end == RetryEnd::kExhausted) {
+    r = Report(PartOutcome::kRetryLater,
+               absl::StrCat("gave up after ", rr.calls, " attempts: ", rr.status.message()));
+  } else if (rr.end == RetryEnd::kFailed) {
+    r = QuarantinePart(
+        id, absl::StrCat(absl::StatusCodeToString(rr.status.code()), ": ", rr.status.message()));
+  } else {
+    auto outputs = OutputsFromRemote(*result);
+    absl::Status written =
+        outputs.ok() ? WritePartOutputs((fs::path(layout_.results) / id).string(), *outputs)
+                     : outputs.status();
+    if (!written.ok()) {  // disk trouble: keep the part in the inbox for the next pass
+      r = Report(PartOutcome::kRetryLater,
+                 absl::StrCat("cannot write results: ", written.message()));
+    } else {
+      r.outcome = PartOutcome::kDone;
+      r.verdict = outputs->verdict;
+      r.min_mm = outputs->min_mm;
+      r.max_mm = outputs->max_mm;
+      // The results are safe; the next pass archives it without a call.
+      if (absl::Status st = MovePart(layout_.inbox, layout_.archive, id); !st.ok())
+        r.message = std::string(st.message());
+    }
+  }
+  r.inspect_calls = rr.calls;
+  return r;
+}
+
+RunSummary CellAgent::Run(const std::atomic<bool>& stop,
+                          const std::function<void(const PartReport&)>& on_part) {
+  RunSummary s;
+  while (!stop.load()) {
+    bool progressed = false;
+    for (const auto& id : CompleteParts(layout_.inbox)) {
+      if (stop.load()) break;
+      const PartReport r = ProcessPart(id, stop);
+      if (on_part) on_part(r);
+      switch (r.outcome) {
+        case PartOutcome::kDone:
+          ++s.done;
+          s.pass += r.verdict == "pass" ? 1 : 0;
+          progressed = true;
+          break;
+        case PartOutcome::kArchivedWithoutCall:
+          ++s.archived_without_call;
+          progressed = true;
+          break;
+        case PartOutcome::kQuarantined:
+          ++s.quarantined;
+          progressed = true;
+          break;
+        case PartOutcome::kConfigError:
+          s.config_error = true;
+          return s;
+        case PartOutcome::kRetryLater:
+        case PartOutcome::kStopped:
+          break;
+      }
+    }
+    if (settings_.once && (!progressed || CompleteParts(layout_.inbox).empty())) break;
+    if (!progressed && !stop.load()) hooks_.sleep(settings_.poll_s, stop);
+  }
+  return s;
+}
+
+}  // namespace surfinspect::client
