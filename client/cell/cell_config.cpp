@@ -96,7 +96,7 @@ absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
   } catch (const nlohmann::json::exception& e) {
     return Bad(path, absl::StrCat("malformed: ", e.what()));
   }
-  if (!(c.error_map.tolerance_mm > 0)) return Bad(path, "tolerance_mm must be > 0");
+  if (auto st = ValidateErrorMapSettings(c.error_map); !st.ok()) return Bad(path, st.message());
   if (auto st = ValidateLinkClusteringSettings(c.filter_settings); !st.ok())
     return Bad(path, st.message());
   return c;

@@ -124,6 +124,15 @@ absl::Status ClusterLinksInto(const PointCloud& cloud, const LinkClusteringSetti
 // InvalidArgument when `result` does not cover this cloud (size mismatch).
 absl::StatusOr<PointCloud> ApplyFilter(const PointCloud& cloud, const LinkClusteringResult& result);
 
+// Clusters `cloud` (ClusterLinksInto) and sets every removed point to NaN in
+// place, as ApplyFilter would: the one filter-then-apply step of every
+// caller. `result` keeps the clustering (labels, clusters, counts, mask) for
+// the caller's statistics and reuses its buffers. Errors as ClusterLinks;
+// `cloud` is unchanged on error.
+absl::Status RemoveOutliers(PointCloud& cloud, const LinkClusteringSettings& settings,
+                            LinkClusteringResult& result,
+                            const std::atomic<bool>* cancel = nullptr);
+
 namespace internal {
 // Shared by both paths once the clusters and their sizes are known: decides
 // `kept` per cluster and fills the counts (not the mask).

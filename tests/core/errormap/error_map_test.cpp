@@ -470,7 +470,7 @@ TEST(ErrorMapOutput, PngOfAMergedCloudLooksAlongTheThinnestAxis) {
   EXPECT_GT(blue, 1000u);
 }
 
-// Acceptance (issue 5): on demo-part scans with planted dents, noise-free,
+// On demo-part scans with planted dents, noise-free,
 // the deviation at the dent centre is within 5 um of the planted depth.
 TEST(ErrorMapDemo, DentCentreDeviationIsThePlantedDepth) {
   const DemoCell cell = MakeDemoCell();

@@ -1,6 +1,6 @@
 // Ground truth for the link-clustering filter: simulated scans of the demo
 // part from its five viewpoints, with sensor noise, ~0.3% pulses, stripes at
-// the steps and planted dents/bumps, scored per pixel label (issue 4).
+// the steps and planted dents/bumps, scored per pixel label.
 #include <gtest/gtest.h>
 
 #include <cstring>

@@ -1,4 +1,4 @@
-// Ground-truth tests of the gauge calibration (issue 6 acceptance): simulated
+// Ground-truth tests of the gauge calibration: simulated
 // gauge scans with noise, pulses and stripes from the demo cell's five
 // viewpoints, the initial guess off by 5 mm and 5 degrees.
 #include "core/registration/calibration.h"
