@@ -187,6 +187,7 @@ absl::StatusOr<ErrorMapResult> ComputeErrorMap(const MeshIndex& index,
                            const Eigen::Vector3d diff =
                                part_from_world * cloud_in_world.points[i].cast<double>() - c.point;
                            r.deviation_xyz_mm[i] = diff.cast<float>();
+                           // The paper's eq. (6): the offset projected on the face normal.
                            r.normal_deviation_mm[i] = static_cast<float>(diff.dot(c.normal));
                          }
                        });

@@ -31,7 +31,7 @@ namespace surfinspect {
 // good points, which is right before ICP (paper §III: fewer good points "will
 // not change the calibration accuracy"). Before an error map, where dents
 // must survive, use ForInspection(). Both measured on simulated demo scans,
-// see tests/core/link_clustering_groundtruth_test.cpp.
+// see tests/core/filter/link_clustering_groundtruth_test.cpp.
 struct LinkClusteringSettings {
   // Two points link when |p - q| <= link_distance_mm (mm, finite, > 0). The
   // paper sets it "according to the resolution of area sensors", 0.1-0.5 mm.

@@ -39,6 +39,7 @@ absl::StatusOr<MergedCloud> RegisterToWorld(const std::vector<ViewScan>& views) 
     const ViewScan& v = views[k];
     out.view_names.push_back(v.name);
     const std::size_t before = pts.size();
+    // Each point through the calibrated pose of the paper's eq. (1).
     v.cloud_in_sensor.ForEachValid([&](std::size_t i, const Eigen::Vector3f& p) {
       pts.push_back((v.world_from_sensor * p.cast<double>()).cast<float>());
       out.view_id.push_back(static_cast<uint16_t>(k));
