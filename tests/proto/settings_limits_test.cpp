@@ -3,6 +3,7 @@
 // the wire refuses the ICP settings ValidateIcpSettings refuses.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -19,7 +20,9 @@ namespace {
 // A minimal cell file with one error-map field set to `value`.
 absl::Status ReadCellWith(const std::string& dir, const std::string& field, double value) {
   nlohmann::json cell = {
-      {"part", {{"mesh", "part.stl"}, {"world_from_part", TransformToJsonValue({})}}},
+      {"part",
+       {{"mesh", "part.stl"},
+        {"world_from_part", TransformToJsonValue(Eigen::Isometry3d::Identity())}}},
       {"viewpoints", {{{"name", "v1"}}}}};
   if (field == "tolerance_mm")
     cell["tolerance_mm"] = value;
