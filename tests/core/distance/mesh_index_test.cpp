@@ -1,3 +1,5 @@
+// Tests of core/distance/mesh_index.cpp and of its batch queries,
+// "core/distance/mesh_index_batch.cpp" (QueryClosest, QueryClosestEach).
 #include "core/distance/mesh_index.h"
 
 #include <gtest/gtest.h>

@@ -1,3 +1,6 @@
+// Tests of core/errormap/error_map.cpp and of its outputs:
+// "core/errormap/error_map_output.cpp" (report, PLY, CSV) and
+// "core/errormap/error_map_png.cpp" (the rendered map).
 #include "core/errormap/error_map.h"
 
 #include <gtest/gtest.h>

@@ -1,3 +1,6 @@
+// Tests of core/filter/link_clustering.cpp and both of its paths against brute
+// force: the grid path "core/filter/link_clustering_grid.cpp" and the
+// unorganized path "core/filter/link_clustering_unorganized.cpp".
 #include "core/filter/link_clustering.h"
 
 #include <gtest/gtest.h>
