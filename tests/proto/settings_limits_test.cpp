@@ -95,7 +95,9 @@ TEST(SettingsLimits, WireRefusesWhatTheIcpValidatorRefuses) {
     s.max_iterations = static_cast<int>(std::min<uint32_t>(iterations, INT32_MAX));
     const absl::Status wire = wire::IcpSettingsFromProto(msg, "icp").status();
     EXPECT_EQ(wire.ok(), ValidateIcpSettings(s).ok()) << iterations << ": " << wire;
-    if (!wire.ok()) EXPECT_NE(wire.message().find("max_iterations"), absl::string_view::npos);
+    if (!wire.ok()) {
+      EXPECT_NE(wire.message().find("max_iterations"), absl::string_view::npos) << wire;
+    }
   }
   v1::IcpSettings msg;
   msg.set_trim_fraction(0.95);
