@@ -1,6 +1,8 @@
 #include "proto/convert.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 
 #include "absl/strings/str_cat.h"
@@ -182,23 +184,15 @@ absl::StatusOr<IcpSettings> IcpSettingsFromProto(const v1::IcpSettings& msg,
     default:
       return Invalid(field + ".step", "unknown step");
   }
-  if (msg.has_max_iterations()) {
-    if (msg.max_iterations() > 10000) return Invalid(field + ".max_iterations", "must be <= 10000");
-    s.max_iterations = static_cast<int>(msg.max_iterations());
-  }
+  // Clamped so a huge uint32 cannot wrap into the valid range; the validator refuses it.
+  if (msg.has_max_iterations())
+    s.max_iterations = static_cast<int>(std::min<uint32_t>(msg.max_iterations(), INT32_MAX));
   if (msg.has_max_correspondence_mm()) s.max_correspondence_mm = msg.max_correspondence_mm();
   if (msg.has_min_correspondence_mm()) s.min_correspondence_mm = msg.min_correspondence_mm();
   if (msg.has_trim_fraction()) s.trim_fraction = msg.trim_fraction();
   if (msg.has_relative_cost_tolerance()) s.relative_cost_tolerance = msg.relative_cost_tolerance();
   if (msg.has_max_points()) s.max_points = msg.max_points();
-  if (!(s.max_correspondence_mm > 0) || !std::isfinite(s.max_correspondence_mm))
-    return Invalid(field + ".max_correspondence_mm", "must be finite and > 0");
-  if (!(s.min_correspondence_mm > 0) || s.min_correspondence_mm > s.max_correspondence_mm)
-    return Invalid(field + ".min_correspondence_mm", "must be > 0 and <= max_correspondence_mm");
-  if (!(s.trim_fraction >= 0 && s.trim_fraction < 0.9))
-    return Invalid(field + ".trim_fraction", "must be in [0, 0.9)");
-  if (!(s.relative_cost_tolerance >= 0) || !std::isfinite(s.relative_cost_tolerance))
-    return Invalid(field + ".relative_cost_tolerance", "must be finite and >= 0");
+  if (auto st = ValidateIcpSettings(s); !st.ok()) return Invalid(field, st.message());
   return s;
 }
 
@@ -241,20 +235,11 @@ absl::StatusOr<ErrorMapSettings> ErrorMapSettingsFromProto(const v1::ErrorMapSet
   if (msg.has_max_distance_mm()) s.max_distance_mm = msg.max_distance_mm();
   if (msg.has_allowed_fraction_outside())
     s.allowed_fraction_outside = msg.allowed_fraction_outside();
-  if (msg.has_histogram_bins()) {
-    if (msg.histogram_bins() > 10001) return Invalid(field + ".histogram_bins", "must be <= 10001");
-    s.histogram_bins = static_cast<int>(msg.histogram_bins());
-  }
+  if (msg.has_histogram_bins())
+    s.histogram_bins = static_cast<int>(std::min<uint32_t>(msg.histogram_bins(), INT32_MAX));
   if (msg.has_histogram_range_mm()) s.histogram_range_mm = msg.histogram_range_mm();
   s.split_components = msg.split_components();
-  if (!(s.tolerance_mm > 0) || !std::isfinite(s.tolerance_mm))
-    return Invalid(field + ".tolerance_mm", "must be finite and > 0");
-  if (!(s.max_distance_mm > 0)) return Invalid(field + ".max_distance_mm", "must be > 0");
-  if (!(s.allowed_fraction_outside >= 0 && s.allowed_fraction_outside <= 1))
-    return Invalid(field + ".allowed_fraction_outside", "must be in [0, 1]");
-  if (s.histogram_bins < 1) return Invalid(field + ".histogram_bins", "must be >= 1");
-  if (!(s.histogram_range_mm >= 0) || !std::isfinite(s.histogram_range_mm))
-    return Invalid(field + ".histogram_range_mm", "must be finite and >= 0");
+  if (auto st = ValidateErrorMapSettings(s); !st.ok()) return Invalid(field, st.message());
   return s;
 }
 

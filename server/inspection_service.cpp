@@ -230,11 +230,10 @@ grpc::ServerUnaryReactor* InspectionService::Filter(grpc::CallbackServerContext*
     if (!cloud.ok()) return FromCore(cloud.status());
     auto settings = wire::FilterSettingsFromProto(req->settings(), "settings");
     if (!settings.ok()) return FromCore(settings.status());
-    auto clusters = ClusterLinks(*cloud, *settings, &cancel);
-    if (!clusters.ok()) return FromCore(clusters.status());
-    auto filtered = ApplyFilter(*cloud, *clusters);
-    if (!filtered.ok()) return FromCore(filtered.status());
-    wire::FilterResultToProto(*filtered, *clusters, resp);
+    LinkClusteringResult clusters;
+    if (auto st = RemoveOutliers(*cloud, *settings, clusters, &cancel); !st.ok())
+      return FromCore(st);
+    wire::FilterResultToProto(*cloud, clusters, resp);
     return grpc::Status::OK;
   });
 }
@@ -293,16 +292,11 @@ grpc::ServerUnaryReactor* InspectionService::Register(grpc::CallbackServerContex
           if (!pose.ok()) return FromCore(pose.status());
           auto cloud = wire::CloudFromProto(v.cloud(), field + ".cloud", config_.limits);
           if (!cloud.ok()) return FromCore(cloud.status());
-          if (req->filter()) {
-            auto clusters = ClusterLinks(*cloud, *filter, &cancel);
-            if (!clusters.ok()) return FromCore(clusters.status());
-            auto cleaned = ApplyFilter(*cloud, *clusters);
-            if (!cleaned.ok()) return FromCore(cleaned.status());
-            cloud = std::move(cleaned);
-          }
           views.push_back(
               {v.name().empty() ? absl::StrCat("view", i) : v.name(), *std::move(cloud), *pose});
         }
+        if (req->filter())
+          if (auto st = FilterViews(views, *filter, &cancel); !st.ok()) return FromCore(st);
         auto merged = RegisterToWorld(views);
         if (!merged.ok()) return FromCore(merged.status());
         if (req->best_fit()) {

@@ -18,6 +18,35 @@ std::string Resolve(const std::string& cell_path, const std::string& p) {
   return (std::filesystem::path(cell_path).parent_path() / p).string();
 }
 
+// One entry of "viewpoints"; nlohmann::json exceptions propagate.
+absl::StatusOr<CellViewpoint> ReadViewpoint(const std::string& path, const nlohmann::json& j,
+                                            std::size_t i) {
+  const nlohmann::json& v = j["viewpoints"][i];
+  const std::string where = absl::StrCat(path, ": viewpoints[", i, "]");
+  CellViewpoint vp;
+  vp.name = v.at("name").get<std::string>();
+  if (vp.name.empty() || vp.name.find('/') != std::string::npos)
+    return Bad(where, "name must be non-empty and contain no '/'");
+  if (v.contains("nominal_world_from_sensor")) {
+    auto t = TransformFromJsonValue(v["nominal_world_from_sensor"],
+                                    where + ".nominal_world_from_sensor");
+    if (!t.ok()) return t.status();
+    vp.nominal_world_from_sensor = *t;
+  }
+  if (v.contains("world_from_gauge")) {
+    auto t = TransformFromJsonValue(v["world_from_gauge"], where + ".world_from_gauge");
+    if (!t.ok()) return t.status();
+    vp.world_from_gauge = *t;
+  }
+  if (v.contains("world_from_sensor") && !v["world_from_sensor"].is_null()) {
+    auto t = TransformFromJsonValue(v["world_from_sensor"], where + ".world_from_sensor");
+    if (!t.ok()) return t.status();
+    vp.world_from_sensor = *t;
+  }
+  if (v.contains("gauge_scan")) vp.gauge_scan = Resolve(path, v["gauge_scan"].get<std::string>());
+  return vp;
+}
+
 }  // namespace
 
 absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
@@ -42,31 +71,9 @@ absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
     if (!j.contains("viewpoints") || !j["viewpoints"].is_array() || j["viewpoints"].empty())
       return Bad(path, "needs a non-empty viewpoints array");
     for (std::size_t i = 0; i < j["viewpoints"].size(); ++i) {
-      const nlohmann::json& v = j["viewpoints"][i];
-      const std::string where = absl::StrCat(path, ": viewpoints[", i, "]");
-      CellViewpoint vp;
-      vp.name = v.at("name").get<std::string>();
-      if (vp.name.empty() || vp.name.find('/') != std::string::npos)
-        return Bad(where, "name must be non-empty and contain no '/'");
-      if (v.contains("nominal_world_from_sensor")) {
-        auto t = TransformFromJsonValue(v["nominal_world_from_sensor"],
-                                        where + ".nominal_world_from_sensor");
-        if (!t.ok()) return t.status();
-        vp.nominal_world_from_sensor = *t;
-      }
-      if (v.contains("world_from_gauge")) {
-        auto t = TransformFromJsonValue(v["world_from_gauge"], where + ".world_from_gauge");
-        if (!t.ok()) return t.status();
-        vp.world_from_gauge = *t;
-      }
-      if (v.contains("world_from_sensor") && !v["world_from_sensor"].is_null()) {
-        auto t = TransformFromJsonValue(v["world_from_sensor"], where + ".world_from_sensor");
-        if (!t.ok()) return t.status();
-        vp.world_from_sensor = *t;
-      }
-      if (v.contains("gauge_scan"))
-        vp.gauge_scan = Resolve(path, v["gauge_scan"].get<std::string>());
-      c.viewpoints.push_back(vp);
+      auto vp = ReadViewpoint(path, j, i);
+      if (!vp.ok()) return vp.status();
+      c.viewpoints.push_back(*std::move(vp));
     }
     if (j.contains("tolerance_mm")) c.error_map.tolerance_mm = j["tolerance_mm"].get<double>();
     if (j.contains("error_map")) {
@@ -96,7 +103,7 @@ absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
   } catch (const nlohmann::json::exception& e) {
     return Bad(path, absl::StrCat("malformed: ", e.what()));
   }
-  if (!(c.error_map.tolerance_mm > 0)) return Bad(path, "tolerance_mm must be > 0");
+  if (auto st = ValidateErrorMapSettings(c.error_map); !st.ok()) return Bad(path, st.message());
   if (auto st = ValidateLinkClusteringSettings(c.filter_settings); !st.ok())
     return Bad(path, st.message());
   return c;

@@ -138,18 +138,14 @@ void AddErrorMapCommand(CLI::App& app) {
   cmd->add_option("--csv", a->csv, "CSV x,y,z,deviation, one row per input point");
   cmd->add_option("--report", a->report, "JSON report");
   cmd->add_option("--png", a->png, "PNG: map, colour bar, histogram");
-  cmd->add_option("--tolerance", a->settings.tolerance_mm, "tolerance band +-MM")
-      ->check(CLI::PositiveNumber)
-      ->default_val(0.1);
+  cmd->add_option("--tolerance", a->settings.tolerance_mm, "tolerance band +-MM")->default_val(0.1);
   cmd->add_option("--max-distance", a->settings.max_distance_mm,
                   "points farther from the CAD are unmatched (NaN), mm")
-      ->check(CLI::PositiveNumber)
       ->default_val(5.0);
   cmd->add_option("--allowed-outside", a->settings.allowed_fraction_outside,
                   "fraction of matched points allowed outside the band for a pass")
-      ->check(CLI::Range(0.0, 1.0))
       ->default_val(0.0);
-  cmd->add_option("--threads", a->settings.threads, "0 = all cores")->check(CLI::Range(0, 1024));
+  cmd->add_option("--threads", a->settings.threads, "0 = all cores");
   cmd->add_flag("--split-components", a->settings.split_components,
                 "also X/Y/Z and normal components (CSV columns, report)");
   cmd->add_option("--frame", a->frame, "coordinates written to PLY/CSV")
@@ -159,7 +155,11 @@ void AddErrorMapCommand(CLI::App& app) {
       ->check(CLI::IsMember({"auto", "x", "y", "z"}))
       ->default_val("auto");
   AddRemoteOptions(cmd, a->remote);
-  cmd->callback([a] { RunErrorMap(*a); });
+  cmd->callback([a] {
+    // Bad parameters are refused before any file is read.
+    Check(ValidateErrorMapSettings(a->settings));
+    RunErrorMap(*a);
+  });
 }
 
 }  // namespace surfinspect::cli

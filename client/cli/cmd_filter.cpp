@@ -66,8 +66,10 @@ void Filter(const FilterArgs& a) {
     wire::FilterSettingsToProto(a.settings, req.mutable_settings());
     resp = Take(Connect(a.remote)->Filter(req));
   } else {
-    const LinkClusteringResult r = Take(ClusterLinks(cloud, a.settings));
-    wire::CloudToProto(Take(ApplyFilter(cloud, r)), resp.mutable_cloud());
+    PointCloud filtered = cloud;  // `cloud` stays whole for the picture
+    LinkClusteringResult r;
+    Check(RemoveOutliers(filtered, a.settings, r));
+    wire::CloudToProto(filtered, resp.mutable_cloud());
     wire::FilterStatsToProto(r, resp.mutable_stats());
     resp.mutable_kept_mask()->assign(r.kept_mask.begin(), r.kept_mask.end());
   }

@@ -27,7 +27,8 @@ void Inspect(const InspectArgs& a) {
   const client::CellConfig cell = Take(client::ReadCellConfig(a.cell));
   const TriangleMesh part = Take(ReadMesh(cell.part_mesh));
   InspectionSettings settings = client::InspectionSettingsOf(cell);
-  if (a.tolerance > 0) settings.error_map.tolerance_mm = a.tolerance;
+  if (a.tolerance != 0) settings.error_map.tolerance_mm = a.tolerance;
+  Check(ValidateErrorMapSettings(settings.error_map));
   std::vector<ViewScan> views;
   for (const auto& vp : cell.viewpoints) {
     const std::string path = a.scans + "/" + vp.name + ".pcd";
@@ -70,8 +71,7 @@ void AddInspectCommand(CLI::App& app) {
                   "results folder (report.json, errormap.ply/.png, deviations.csv)")
       ->required();
   cmd->add_option("--part-id", a->part_id, "default: the scans folder's name");
-  cmd->add_option("--tolerance", a->tolerance, "override the cell's tolerance, mm")
-      ->check(CLI::PositiveNumber);
+  cmd->add_option("--tolerance", a->tolerance, "override the cell's tolerance, mm (0 = keep)");
   AddRemoteOptions(cmd, a->remote);
   cmd->callback([a] { Inspect(*a); });
 }

@@ -37,15 +37,10 @@ void Register(const RegisterArgs& a) {
   } else {
     std::vector<ViewScan> views;
     const wire::Limits limits;
-    for (const auto& v : req.views()) {
-      PointCloud cloud = Take(wire::CloudFromProto(v.cloud(), v.name(), limits));
-      if (a.filter) {
-        const LinkClusteringResult r = Take(ClusterLinks(cloud, LinkClusteringSettings{}));
-        cloud = Take(ApplyFilter(cloud, r));
-      }
-      views.push_back({v.name(), std::move(cloud),
+    for (const auto& v : req.views())
+      views.push_back({v.name(), Take(wire::CloudFromProto(v.cloud(), v.name(), limits)),
                        Take(wire::TransformFromProto(v.world_from_sensor(), v.name()))});
-    }
+    if (a.filter) Check(FilterViews(views, LinkClusteringSettings{}));
     merged = Take(RegisterToWorld(views)).cloud_in_world;
   }
   Check(WritePointCloud(a.out, merged));

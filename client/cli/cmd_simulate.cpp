@@ -7,6 +7,7 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_split.h"
+#include "client/cell/demo_cell_files.h"
 #include "client/cli/commands.h"
 #include "core/io/atomic_file.h"
 #include "core/io/io_mesh.h"
@@ -77,13 +78,13 @@ void Simulate(const SimulateArgs& a) {
 
 void WriteCell(const std::string& out, int parts, uint64_t seed) {
   const auto t0 = std::chrono::steady_clock::now();
-  DemoWriteOptions opt;
+  client::DemoWriteOptions opt;
   opt.parts = parts;
   opt.scan.noise_sigma_mm = 0.015;
   opt.scan.pulse_fraction = 0.003;
   opt.scan.stripes = true;
   opt.scan.seed = seed;
-  Check(WriteDemoCell(out, MakeDemoCell(), opt));
+  Check(client::WriteDemoCell(out, MakeDemoCell(), opt));
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("demo cell written to %s in %.1f s:\n", out.c_str(), s);
   std::printf("  part.stl, gauge.stl        CAD meshes (mm)\n");

@@ -120,9 +120,11 @@ class MeshIndex {
   std::unique_ptr<EmbreeTriangleScene> scene_;
 };
 
+constexpr int kMaxQueryThreads = 1024;  // the largest task arena a batch query makes
+
 struct BatchQuerySettings {
   double max_distance_mm = INFINITY;  // points farther from the mesh are unmatched (NaN)
-  int threads = 0;                    // 0 = all cores; results do not depend on it
+  int threads = 0;  // in [0, kMaxQueryThreads], 0 = all cores; results do not depend on it
   // Exploit coherence: visit points in a spatially coherent order (the
   // sensor grid for organized clouds, Morton order otherwise) and start each
   // query's radius at previous distance + |p - p_prev| (triangle

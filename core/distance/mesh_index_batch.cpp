@@ -20,12 +20,12 @@
 #include "absl/strings/str_cat.h"
 #include "core/distance/mesh_index.h"
 #include "core/types/cancel.h"
+#include "core/types/radix_sort.h"
 
 namespace surfinspect {
 namespace {
 
 constexpr std::size_t kChunk = 256;  // points per chunk: the unit of work and of cancel polling
-constexpr int kMaxThreads = 1024;
 
 // Spreads the low 10 bits of v to every third bit (Morton interleave).
 uint64_t Spread10(uint64_t v) {
@@ -42,14 +42,15 @@ uint64_t Spread10(uint64_t v) {
 constexpr std::size_t kCancelStride = std::size_t{1} << 16;
 
 // Visiting order for an unorganized cloud: 30-bit Morton codes on a 1024^3
-// grid over the bounds, sorted by an LSD radix sort (stable, so equal codes
-// keep input order). Invalid points go last. Empty if cancelled.
+// grid over the bounds, sorted by a stable radix sort (equal codes keep
+// input order). Invalid points go last. Empty if cancelled.
 std::vector<uint32_t> MortonOrder(const PointCloud& cloud, const std::atomic<bool>* cancel) {
   const Bounds3 bounds = ComputeBounds(cloud);
   const std::size_t n = cloud.size();
   const double extent = bounds.empty() ? 0.0 : (bounds.max - bounds.min).maxCoeff();
   const double scale = extent > 0 ? 1023.0 / extent : 0.0;
-  std::vector<uint64_t> keys(n), tmp(n);
+  std::vector<uint64_t> keys(n);
+  std::vector<uint32_t> order(n);
   for (std::size_t i = 0; i < n; ++i) {
     if (i % kCancelStride == 0 && IsCancelled(cancel)) return {};
     const Eigen::Vector3f& p = cloud.points[i];
@@ -60,20 +61,10 @@ std::vector<uint32_t> MortonOrder(const PointCloud& cloud, const std::atomic<boo
         q[a] = static_cast<uint64_t>(std::clamp((p[a] - bounds.min[a]) * scale, 0.0, 1023.0));
       code = Spread10(q[0]) | (Spread10(q[1]) << 1) | (Spread10(q[2]) << 2);
     }
-    keys[i] = (code << 32) | i;
+    keys[i] = code;
+    order[i] = static_cast<uint32_t>(i);
   }
-  for (int shift = 32; shift < 64; shift += 11) {
-    std::array<std::size_t, 2049> start{};
-    for (uint64_t k : keys) ++start[((k >> shift) & 2047) + 1];
-    for (int d = 0; d < 2048; ++d) start[d + 1] += start[d];
-    for (std::size_t i = 0; i < n; ++i) {
-      if (i % kCancelStride == 0 && IsCancelled(cancel)) return {};
-      tmp[start[(keys[i] >> shift) & 2047]++] = keys[i];
-    }
-    keys.swap(tmp);
-  }
-  std::vector<uint32_t> order(n);
-  for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<uint32_t>(keys[i]);
+  if (!RadixSortPairs(keys, order, 31, cancel)) return {};
   return order;
 }
 
@@ -84,9 +75,9 @@ absl::Status CheckInputs(const PointCloud& points, const Eigen::Isometry3d& mesh
     return absl::InvalidArgumentError(
         absl::StrCat("closest-point query: max_distance_mm must be >= 0 (or inf), got ",
                      settings.max_distance_mm));
-  if (settings.threads < 0 || settings.threads > kMaxThreads)
+  if (settings.threads < 0 || settings.threads > kMaxQueryThreads)
     return absl::InvalidArgumentError(absl::StrCat("closest-point query: threads must be in [0, ",
-                                                   kMaxThreads, "], got ", settings.threads));
+                                                   kMaxQueryThreads, "], got ", settings.threads));
   if (!mesh_from_points.matrix().allFinite())
     return absl::InvalidArgumentError("closest-point query: mesh_from_points is not finite");
   return absl::OkStatus();

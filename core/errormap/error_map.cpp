@@ -7,6 +7,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "core/types/cancel.h"
+#include "core/types/percentile.h"
 
 namespace surfinspect {
 namespace {
@@ -26,45 +27,6 @@ bool FillUnlessCancelled(std::vector<T>& v, std::size_t n, const T& value,
   }
   return true;
 }
-
-absl::Status CheckSettings(const ErrorMapSettings& s) {
-  auto bad = [](absl::string_view what, double v) {
-    return absl::InvalidArgumentError(absl::StrCat("error map: ", what, ", got ", v));
-  };
-  if (!(s.tolerance_mm > 0) || !std::isfinite(s.tolerance_mm))
-    return bad("tolerance_mm must be a positive number", s.tolerance_mm);
-  if (!(s.max_distance_mm > 0))
-    return bad("max_distance_mm must be > 0 (inf allowed)", s.max_distance_mm);
-  if (!(s.allowed_fraction_outside >= 0 && s.allowed_fraction_outside <= 1))
-    return bad("allowed_fraction_outside must be in [0, 1]", s.allowed_fraction_outside);
-  if (s.histogram_bins < 1 || s.histogram_bins > 100000)
-    return bad("histogram_bins must be in [1, 100000]", s.histogram_bins);
-  if (!(s.histogram_range_mm >= 0) || !std::isfinite(s.histogram_range_mm))
-    return bad("histogram_range_mm must be >= 0 (0 = auto)", s.histogram_range_mm);
-  return absl::OkStatus();
-}
-
-// Percentile q in [0, 1] of v (NumPy's default "linear" rule). Reorders v;
-// calls must come in increasing q so each nth_element works on the tail.
-class Percentiles {
- public:
-  explicit Percentiles(std::vector<float>& v) : v_(v) {}
-  double At(double q) {
-    const double pos = q * static_cast<double>(v_.size() - 1);
-    const auto lo = static_cast<std::size_t>(pos);
-    std::nth_element(v_.begin() + static_cast<std::ptrdiff_t>(done_),
-                     v_.begin() + static_cast<std::ptrdiff_t>(lo), v_.end());
-    done_ = lo;
-    const double a = v_[lo];
-    if (lo + 1 >= v_.size()) return a;
-    const double b = *std::min_element(v_.begin() + static_cast<std::ptrdiff_t>(lo + 1), v_.end());
-    return a + (pos - static_cast<double>(lo)) * (b - a);
-  }
-
- private:
-  std::vector<float>& v_;
-  std::size_t done_ = 0;
-};
 
 ComponentStats Summarize(const std::vector<double>& values) {
   ComponentStats c;
@@ -109,7 +71,7 @@ void ComputeStats(const ErrorMapSettings& settings, ErrorMapResult& r) {
     r.stats.mean_mm = s.mean_mm;
     r.stats.rms_mm = s.rms_mm;
     r.stats.stddev_mm = std::sqrt(var / as_double.size());
-    Percentiles p(matched);
+    Percentiles<float> p(matched);  // increasing q, as it requires
     r.stats.p1_mm = p.At(0.01);
     r.stats.p5_mm = p.At(0.05);
     r.stats.p50_mm = p.At(0.50);
@@ -151,6 +113,26 @@ void ComputeStats(const ErrorMapSettings& settings, ErrorMapResult& r) {
 
 }  // namespace
 
+absl::Status ValidateErrorMapSettings(const ErrorMapSettings& s) {
+  auto bad = [](absl::string_view what, double v) {
+    return absl::InvalidArgumentError(absl::StrCat("error map: ", what, ", got ", v));
+  };
+  if (!(s.tolerance_mm > 0) || !std::isfinite(s.tolerance_mm))
+    return bad("tolerance_mm must be a positive number", s.tolerance_mm);
+  if (!(s.max_distance_mm > 0))
+    return bad("max_distance_mm must be > 0 (inf allowed)", s.max_distance_mm);
+  if (!(s.allowed_fraction_outside >= 0 && s.allowed_fraction_outside <= 1))
+    return bad("allowed_fraction_outside must be in [0, 1]", s.allowed_fraction_outside);
+  if (s.histogram_bins < 1 || s.histogram_bins > kMaxHistogramBins)
+    return bad(absl::StrCat("histogram_bins must be in [1, ", kMaxHistogramBins, "]"),
+               s.histogram_bins);
+  if (!(s.histogram_range_mm >= 0) || !std::isfinite(s.histogram_range_mm))
+    return bad("histogram_range_mm must be >= 0 (0 = auto)", s.histogram_range_mm);
+  if (s.threads < 0 || s.threads > kMaxQueryThreads)
+    return bad(absl::StrCat("threads must be in [0, ", kMaxQueryThreads, "]"), s.threads);
+  return absl::OkStatus();
+}
+
 double AutoColorRange(double tolerance_mm, double p1_mm, double p99_mm) {
   double want = 2 * tolerance_mm;
   if (std::isfinite(p1_mm)) want = std::max(want, std::abs(p1_mm));
@@ -166,7 +148,7 @@ absl::StatusOr<ErrorMapResult> ComputeErrorMap(const MeshIndex& index,
                                                const Eigen::Isometry3d& world_from_part,
                                                const ErrorMapSettings& settings,
                                                const std::atomic<bool>* cancel) {
-  if (auto st = CheckSettings(settings); !st.ok()) return st;
+  if (auto st = ValidateErrorMapSettings(settings); !st.ok()) return st;
   const absl::Status cancelled = absl::CancelledError("error map cancelled");
   if (IsCancelled(cancel)) return cancelled;
   if (auto st = cloud_in_world.Validate(); !st.ok()) return st;
@@ -205,6 +187,7 @@ absl::StatusOr<ErrorMapResult> ComputeErrorMap(const MeshIndex& index,
                            const Eigen::Vector3d diff =
                                part_from_world * cloud_in_world.points[i].cast<double>() - c.point;
                            r.deviation_xyz_mm[i] = diff.cast<float>();
+                           // The paper's eq. (6): the offset projected on the face normal.
                            r.normal_deviation_mm[i] = static_cast<float>(diff.dot(c.normal));
                          }
                        });

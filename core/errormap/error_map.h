@@ -17,11 +17,15 @@
 #include <string>
 #include <vector>
 
+#include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "core/distance/mesh_index.h"
 #include "core/types/point_cloud.h"
 
 namespace surfinspect {
+
+// 100000 bins are 0.8 MB of counts, far below a reply's size limit.
+constexpr int kMaxHistogramBins = 100000;
 
 struct ErrorMapSettings {
   double tolerance_mm = 0.1;     // the +-tol band; > 0
@@ -31,11 +35,15 @@ struct ErrorMapSettings {
   // default 0 is the strict metrology reading (every measured point within
   // tolerance); raise it to tolerate residual noise that filtering kept.
   double allowed_fraction_outside = 0.0;
-  int histogram_bins = 41;        // odd, so one bin is centred on 0
+  int histogram_bins = 41;        // odd, so one bin is centred on 0; <= kMaxHistogramBins
   double histogram_range_mm = 0;  // half-width of the histogram and colour scale; 0 = auto
   bool split_components = false;  // also fill the X/Y/Z and normal components
-  int threads = 0;                // 0 = all cores
+  int threads = 0;                // 0 = all cores; <= kMaxQueryThreads
 };
+
+// Checks the settings: InvalidArgument naming the bad field. ComputeErrorMap,
+// the wire conversion, the CLI and the cell file all use it.
+absl::Status ValidateErrorMapSettings(const ErrorMapSettings& settings);
 
 struct ErrorMapStats {
   std::size_t count = 0;    // input points, NaN pixels included
@@ -43,7 +51,8 @@ struct ErrorMapStats {
   std::size_t matched = 0;  // valid points within max_distance_mm of the mesh
   // Over the matched signed deviations, mm; NaN when nothing matched.
   double min_mm = NAN, max_mm = NAN, mean_mm = NAN, stddev_mm = NAN, rms_mm = NAN;
-  // Percentiles 1/5/50/95/99 (linear interpolation between order statistics).
+  // Percentiles 1/5/50/95/99 (linear interpolation between order statistics,
+  // core/types/percentile.h).
   double p1_mm = NAN, p5_mm = NAN, p50_mm = NAN, p95_mm = NAN, p99_mm = NAN;
 };
 

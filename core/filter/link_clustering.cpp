@@ -13,6 +13,14 @@ namespace {
 
 constexpr int32_t kInvalid = LinkClusteringResult::kInvalid;
 
+// Only removed points change; no-data pixels keep their exact bits too.
+// `result` covers `cloud` point for point.
+void SetRemovedToNaN(const LinkClusteringResult& result, PointCloud& cloud) {
+  const Eigen::Vector3f nan = Eigen::Vector3f::Constant(NAN);
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    if (!result.kept_mask[i] && result.labels[i] != kInvalid) cloud.points[i] = nan;
+}
+
 }  // namespace
 
 absl::Status ValidateLinkClusteringSettings(const LinkClusteringSettings& s) {
@@ -99,11 +107,15 @@ absl::StatusOr<PointCloud> ApplyFilter(const PointCloud& cloud,
                                                    result.labels.size(),
                                                    " points but the cloud has ", cloud.size()));
   PointCloud out = cloud;
-  const Eigen::Vector3f nan = Eigen::Vector3f::Constant(NAN);
-  // Only removed points change; no-data pixels keep their exact bits too.
-  for (std::size_t i = 0; i < out.size(); ++i)
-    if (!result.kept_mask[i] && result.labels[i] != kInvalid) out.points[i] = nan;
+  SetRemovedToNaN(result, out);
   return out;
+}
+
+absl::Status RemoveOutliers(PointCloud& cloud, const LinkClusteringSettings& settings,
+                            LinkClusteringResult& result, const std::atomic<bool>* cancel) {
+  if (auto st = ClusterLinksInto(cloud, settings, result, cancel); !st.ok()) return st;
+  SetRemovedToNaN(result, cloud);
+  return absl::OkStatus();
 }
 
 }  // namespace surfinspect

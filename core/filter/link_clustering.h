@@ -31,7 +31,7 @@ namespace surfinspect {
 // good points, which is right before ICP (paper §III: fewer good points "will
 // not change the calibration accuracy"). Before an error map, where dents
 // must survive, use ForInspection(). Both measured on simulated demo scans,
-// see tests/core/link_clustering_groundtruth_test.cpp.
+// see tests/core/filter/link_clustering_groundtruth_test.cpp.
 struct LinkClusteringSettings {
   // Two points link when |p - q| <= link_distance_mm (mm, finite, > 0). The
   // paper sets it "according to the resolution of area sensors", 0.1-0.5 mm.
@@ -123,6 +123,15 @@ absl::Status ClusterLinksInto(const PointCloud& cloud, const LinkClusteringSetti
 // stays the same grid, and kept (and no-data) points are copied bit for bit.
 // InvalidArgument when `result` does not cover this cloud (size mismatch).
 absl::StatusOr<PointCloud> ApplyFilter(const PointCloud& cloud, const LinkClusteringResult& result);
+
+// Clusters `cloud` (ClusterLinksInto) and sets every removed point to NaN in
+// place, as ApplyFilter would: the one filter-then-apply step of every
+// caller. `result` keeps the clustering (labels, clusters, counts, mask) for
+// the caller's statistics and reuses its buffers. Errors as ClusterLinks;
+// `cloud` is unchanged on error.
+absl::Status RemoveOutliers(PointCloud& cloud, const LinkClusteringSettings& settings,
+                            LinkClusteringResult& result,
+                            const std::atomic<bool>* cancel = nullptr);
 
 namespace internal {
 // Shared by both paths once the clusters and their sizes are known: decides

@@ -3,12 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <numeric>
-#include <utility>
 #include <vector>
 
+#include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
+#include "core/filter/union_find.h"
 #include "core/types/cancel.h"
+#include "core/types/radix_sort.h"
 
 namespace surfinspect {
 namespace {
@@ -22,42 +23,6 @@ int BitsFor(uint64_t v) {
   while (b < 64 && (v >> b) != 0) ++b;
   return b;
 }
-
-// LSD radix sort of (key, value) pairs by the low `key_bits` bits of key,
-// 11-bit digits: O(n) per pass, and a 300 mm part at 0.5 mm cells needs
-// only 2-3 passes. `keys`/`values` hold the sorted result on return.
-void RadixSort(std::vector<uint64_t>& keys, std::vector<uint32_t>& values, int key_bits) {
-  constexpr int kDigitBits = 11;
-  constexpr std::size_t kBuckets = std::size_t{1} << kDigitBits;
-  std::vector<uint64_t> keys_tmp(keys.size());
-  std::vector<uint32_t> values_tmp(values.size());
-  std::vector<std::size_t> start(kBuckets);
-  for (int shift = 0; shift < key_bits; shift += kDigitBits) {
-    std::fill(start.begin(), start.end(), 0);
-    for (uint64_t k : keys) ++start[(k >> shift) & (kBuckets - 1)];
-    std::size_t sum = 0;
-    for (auto& s : start) sum += std::exchange(s, sum);
-    for (std::size_t i = 0; i < keys.size(); ++i) {
-      const std::size_t to = start[(keys[i] >> shift) & (kBuckets - 1)]++;
-      keys_tmp[to] = keys[i];
-      values_tmp[to] = values[i];
-    }
-    keys.swap(keys_tmp);
-    values.swap(values_tmp);
-  }
-}
-
-// Union-find over cells; path halving, the smaller index becomes the root.
-struct Forest {
-  std::vector<int32_t> parent;
-  int32_t Find(int32_t i) {
-    while (parent[i] != i) {
-      parent[i] = parent[parent[i]];
-      i = parent[i];
-    }
-    return i;
-  }
-};
 
 // The valid points sorted by cell, as structure-of-arrays, and the cells.
 struct SortedCells {
@@ -78,73 +43,85 @@ bool AnyLinked(const SortedCells& s, uint32_t a, uint32_t b, float r2) {
   return false;
 }
 
-}  // namespace
-
-absl::Status ClusterLinksUnorganized(const PointCloud& cloud,
-                                     const LinkClusteringSettings& settings,
-                                     LinkClusteringResult& result,
-                                     const std::atomic<bool>* cancel) {
-  if (auto st = internal::CheckInput(cloud, settings); !st.ok()) return st;
-  auto cancelled = [&] { return IsCancelled(cancel); };
-  const std::size_t n = cloud.size();
-  result.input_points = n;
-  result.organized_path = false;
-  result.clusters.clear();
-  result.labels.assign(n, kInvalid);
-
+// The valid points' bounds and count; InvalidArgument on an infinite
+// coordinate.
+struct ValidBounds {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
-  std::size_t m = 0;
-  for (std::size_t i = 0; i < n; ++i) {
+  std::size_t count = 0;
+};
+absl::StatusOr<ValidBounds> BoundValidPoints(const PointCloud& cloud) {
+  ValidBounds b;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
     const Eigen::Vector3f& p = cloud.points[i];
     if (PointCloud::IsValid(p)) {
-      lo = lo.cwiseMin(p.cast<double>());
-      hi = hi.cwiseMax(p.cast<double>());
-      ++m;
+      b.lo = b.lo.cwiseMin(p.cast<double>());
+      b.hi = b.hi.cwiseMax(p.cast<double>());
+      ++b.count;
     } else if (p.array().isInf().any()) {
       return absl::InvalidArgumentError(
           absl::StrCat("link clustering: point ", i, " has an infinite coordinate"));
     }
   }
+  return b;
+}
+
+// The cell grid: cells of edge d / sqrt(3) and the bits per axis of the
+// packed key (z, y, x major to minor).
+struct CellGrid {
+  Eigen::Vector3d lo;
+  double cell = 0;
+  int bits[3] = {0, 0, 0};
+  int key_bits() const { return bits[0] + bits[1] + bits[2]; }
+  uint64_t Key(const Eigen::Vector3f& p) const {
+    uint64_t c[3];
+    for (int a = 0; a < 3; ++a) c[a] = static_cast<uint64_t>(std::floor((p[a] - lo[a]) / cell)) + 2;
+    return c[0] | (c[1] << bits[0]) | (c[2] << (bits[0] + bits[1]));
+  }
+};
+absl::StatusOr<CellGrid> MakeCellGrid(const ValidBounds& b, double link_distance_mm) {
+  CellGrid g;
+  g.lo = b.lo;
   // Cells of edge d / sqrt(3), shrunk by 1e-4 so that float rounding in
   // PointsLinked can never fail to link two points of the same cell (their
   // true distance is < 0.9999 d; the float error is ~1e-7 relative).
-  const double cell = settings.link_distance_mm / std::sqrt(3.0) * (1.0 - 1e-4);
-  int bits[3] = {0, 0, 0};
-  for (int a = 0; m > 0 && a < 3; ++a) {
+  g.cell = link_distance_mm / std::sqrt(3.0) * (1.0 - 1e-4);
+  for (int a = 0; b.count > 0 && a < 3; ++a) {
     // Cell coordinates start at 2 so that x-2 and y-2 never borrow across
     // key fields, and stop 2 below the field's top so that x+2 fits.
-    const double cells = std::floor((hi[a] - lo[a]) / cell) + 5.0;
+    const double cells = std::floor((b.hi[a] - b.lo[a]) / g.cell) + 5.0;
     if (!(cells < static_cast<double>(uint64_t{1} << kMaxAxisBits)))
-      return absl::InvalidArgumentError(absl::StrCat(
-          "link clustering: the cloud spans ", hi[a] - lo[a], " mm on axis ", a,
-          ", more than 2^21 cells for a link distance of ", settings.link_distance_mm, " mm"));
-    bits[a] = BitsFor(static_cast<uint64_t>(cells) - 1);
+      return absl::InvalidArgumentError(
+          absl::StrCat("link clustering: the cloud spans ", b.hi[a] - b.lo[a], " mm on axis ", a,
+                       ", more than 2^21 cells for a link distance of ", link_distance_mm, " mm"));
+    g.bits[a] = BitsFor(static_cast<uint64_t>(cells) - 1);
   }
+  return g;
+}
 
+// The valid points sorted by cell key; `order` maps sorted position to point
+// index. False when cancelled.
+bool SortByCell(const PointCloud& cloud, const CellGrid& grid, std::size_t valid, SortedCells& s,
+                std::vector<uint32_t>& order, const std::atomic<bool>* cancel) {
   std::vector<uint64_t> keys;
-  std::vector<uint32_t> order;  // sorted position -> point index
-  keys.reserve(m);
-  order.reserve(m);
-  for (std::size_t i = 0; i < n; ++i) {
+  keys.reserve(valid);
+  order.clear();
+  order.reserve(valid);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
     const Eigen::Vector3f& p = cloud.points[i];
     if (!PointCloud::IsValid(p)) continue;
-    uint64_t c[3];
-    for (int a = 0; a < 3; ++a) c[a] = static_cast<uint64_t>(std::floor((p[a] - lo[a]) / cell)) + 2;
-    keys.push_back(c[0] | (c[1] << bits[0]) | (c[2] << (bits[0] + bits[1])));
+    keys.push_back(grid.Key(p));
     order.push_back(static_cast<uint32_t>(i));
   }
-  if (cancelled()) return absl::CancelledError("link clustering: cancelled");
-  RadixSort(keys, order, bits[0] + bits[1] + bits[2]);
-
-  SortedCells s;
-  s.x.resize(m);
-  s.y.resize(m);
-  s.z.resize(m);
-  s.cell_of.resize(m);
-  for (std::size_t k = 0; k < m; ++k) {
+  if (IsCancelled(cancel)) return false;
+  RadixSortPairs(keys, order, grid.key_bits());
+  s.x.resize(valid);
+  s.y.resize(valid);
+  s.z.resize(valid);
+  s.cell_of.resize(valid);
+  for (std::size_t k = 0; k < valid; ++k) {
     // A gather in cell order: random reads of an unorganized cloud, so the
     // point needed 16 steps later is requested now.
-    if (k + 16 < m) __builtin_prefetch(&cloud.points[order[k + 16]]);
+    if (k + 16 < valid) __builtin_prefetch(&cloud.points[order[k + 16]]);
     const Eigen::Vector3f& p = cloud.points[order[k]];
     s.x[k] = p.x();
     s.y[k] = p.y();
@@ -155,15 +132,18 @@ absl::Status ClusterLinksUnorganized(const PointCloud& cloud,
     }
     s.cell_of[k] = static_cast<uint32_t>(s.key.size() - 1);
   }
-  const auto num_cells = static_cast<uint32_t>(s.key.size());
-  s.begin.push_back(static_cast<uint32_t>(m));
+  s.begin.push_back(static_cast<uint32_t>(valid));
+  return true;
+}
 
-  Forest forest;
-  forest.parent.resize(num_cells);
-  std::iota(forest.parent.begin(), forest.parent.end(), 0);
-  const float r2 = LinkDistanceSquared(settings.link_distance_mm);
-  const uint64_t step_y = uint64_t{1} << bits[0];
-  const uint64_t step_z = uint64_t{1} << (bits[0] + bits[1]);
+// Merges every pair of linked cells (see the header: forward neighbours
+// only, found by cursors over the sorted keys). False when cancelled.
+bool LinkCells(const SortedCells& s, const CellGrid& grid, float r2, UnionFind& forest,
+               const std::atomic<bool>* cancel) {
+  const auto num_cells = static_cast<uint32_t>(s.key.size());
+  forest.Reset(num_cells);
+  const uint64_t step_y = uint64_t{1} << grid.bits[0];
+  const uint64_t step_z = uint64_t{1} << (grid.bits[0] + grid.bits[1]);
   // Forward neighbour rows (dy, dz) whose cells x-2..x+2 are one key range:
   // dz = 0 with dy = 1, 2, and dz = 1, 2 with dy = -2..2. The cells x+1 and
   // x+2 of the cell's own row follow it directly in the sorted order.
@@ -177,18 +157,13 @@ absl::Status ClusterLinksUnorganized(const PointCloud& cloud,
     while (cursor < num_cells && s.key[cursor] < first_key_not_before) ++cursor;
   };
   for (uint32_t a = 0; a < num_cells; ++a) {
-    if ((a & 4095) == 0 && cancelled()) return absl::CancelledError("link clustering: cancelled");
+    if ((a & 4095) == 0 && IsCancelled(cancel)) return false;
     const uint64_t key = s.key[a];
     int32_t root_a = forest.Find(static_cast<int32_t>(a));
     auto try_link = [&](uint32_t b) {
       const int32_t root_b = forest.Find(static_cast<int32_t>(b));
       if (root_b == root_a || !AnyLinked(s, a, b, r2)) return;
-      if (root_a < root_b) {
-        forest.parent[root_b] = root_a;
-      } else {
-        forest.parent[root_a] = root_b;
-        root_a = root_b;
-      }
+      root_a = forest.LinkRoots(root_a, root_b);
     };
     for (uint32_t b = a + 1; b < num_cells && s.key[b] <= key + 2; ++b) try_link(b);
     for (int k = 0; k < rows; ++k) {
@@ -197,14 +172,19 @@ absl::Status ClusterLinksUnorganized(const PointCloud& cloud,
       for (uint32_t b = row_first[k]; b < num_cells && s.key[b] <= last_key; ++b) try_link(b);
     }
   }
+  return true;
+}
 
-  // Each point's root cell, found in cell order (local) and scattered to
-  // the point's index; then ids in order of each component's first point
-  // index, with statistics.
-  for (std::size_t k = 0; k < m; ++k)
+// Each point's root cell, found in cell order (local) and scattered to the
+// point's index; then ids in order of each component's first point index,
+// with statistics.
+void NumberComponents(const PointCloud& cloud, const SortedCells& s,
+                      const std::vector<uint32_t>& order, UnionFind& forest,
+                      LinkClusteringResult& result) {
+  for (std::size_t k = 0; k < order.size(); ++k)
     result.labels[order[k]] = forest.Find(static_cast<int32_t>(s.cell_of[k]));
-  std::vector<int32_t> id_of_root(num_cells, kInvalid);
-  for (std::size_t i = 0; i < n; ++i) {
+  std::vector<int32_t> id_of_root(s.key.size(), kInvalid);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
     if (result.labels[i] == kInvalid) continue;
     int32_t& id = id_of_root[result.labels[i]];
     const Eigen::Vector3f& p = cloud.points[i];
@@ -223,6 +203,31 @@ absl::Status ClusterLinksUnorganized(const PointCloud& cloud,
     k.max = k.max.cwiseMax(p);
     result.labels[i] = id;
   }
+}
+
+}  // namespace
+
+absl::Status ClusterLinksUnorganized(const PointCloud& cloud,
+                                     const LinkClusteringSettings& settings,
+                                     LinkClusteringResult& result,
+                                     const std::atomic<bool>* cancel) {
+  if (auto st = internal::CheckInput(cloud, settings); !st.ok()) return st;
+  const absl::Status cancelled = absl::CancelledError("link clustering: cancelled");
+  result.input_points = cloud.size();
+  result.organized_path = false;
+  result.clusters.clear();
+  result.labels.assign(cloud.size(), kInvalid);
+  auto bounds = BoundValidPoints(cloud);
+  if (!bounds.ok()) return bounds.status();
+  auto grid = MakeCellGrid(*bounds, settings.link_distance_mm);
+  if (!grid.ok()) return grid.status();
+  SortedCells cells;
+  std::vector<uint32_t> order;  // sorted position -> point index
+  if (!SortByCell(cloud, *grid, bounds->count, cells, order, cancel)) return cancelled;
+  UnionFind forest;
+  if (!LinkCells(cells, *grid, LinkDistanceSquared(settings.link_distance_mm), forest, cancel))
+    return cancelled;
+  NumberComponents(cloud, cells, order, forest, result);
   internal::DecideClusters(settings, result);
   internal::FillKeptMaskFromLabels(result);
   return absl::OkStatus();

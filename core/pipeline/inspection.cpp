@@ -18,22 +18,20 @@ absl::StatusOr<InspectionResult> InspectPart(const MeshIndex& part,
                                              const std::atomic<bool>* cancel) {
   if (views.empty()) return absl::InvalidArgumentError("inspect: no views");
   InspectionResult out;
-  LinkClusteringResult clusters;  // buffers reused across views
-  for (ViewScan& v : views) {
+  for (const ViewScan& v : views) {
     ViewOutcome outcome;
     outcome.name = v.name;
     outcome.valid_points = v.cloud_in_sensor.CountValid();
-    if (settings.filter) {
-      if (auto st = ClusterLinksInto(v.cloud_in_sensor, settings.filter_settings, clusters, cancel);
-          !st.ok())
-        return absl::Status(st.code(), absl::StrCat("view '", v.name, "': ", st.message()));
-      auto cleaned = ApplyFilter(v.cloud_in_sensor, clusters);
-      if (!cleaned.ok()) return cleaned.status();
-      v.cloud_in_sensor = *std::move(cleaned);
-      outcome.removed_points = clusters.removed;
-      if (progress) progress(InspectionStage::kViewFiltered, v.name, clusters.kept);
-    }
     out.views.push_back(outcome);
+  }
+  if (settings.filter) {
+    std::size_t k = 0;
+    auto on_view = [&](const ViewScan& v, const LinkClusteringResult& clusters) {
+      out.views[k++].removed_points = clusters.removed;
+      if (progress) progress(InspectionStage::kViewFiltered, v.name, clusters.kept);
+    };
+    if (auto st = FilterViews(views, settings.filter_settings, cancel, on_view); !st.ok())
+      return st;
   }
   auto merged = RegisterToWorld(views);
   if (!merged.ok()) return merged.status();

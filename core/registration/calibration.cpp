@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
+#include "core/types/percentile.h"
 #include "core/types/transform.h"
 
 namespace surfinspect {
@@ -15,13 +16,6 @@ Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
   Eigen::Matrix3d s;
   s << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
   return s;
-}
-
-double Percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  const std::size_t k = std::min(v.size() - 1, std::size_t(q * (v.size() - 1) + 0.5));
-  std::nth_element(v.begin(), v.begin() + k, v.end());
-  return v[k];
 }
 
 // λmin/λmax of the normal matrix re-expressed about the inliers' centroid c
@@ -111,47 +105,18 @@ absl::StatusOr<Eigen::Isometry3d> CoarseSearch(const MeshIndex& gauge, const Poi
   return best;
 }
 
-}  // namespace
-
-absl::StatusOr<CalibrationResult> CalibrateViewpoint(
-    const MeshIndex& gauge, const Eigen::Isometry3d& world_from_gauge,
-    const PointCloud& scan_in_sensor, const Eigen::Isometry3d& initial_world_from_sensor,
-    const CalibrationSettings& s, const std::atomic<bool>* cancel) {
+absl::Status CheckCalibrationSettings(const CalibrationSettings& s) {
   if (!(s.degeneracy_threshold >= 0 && s.degeneracy_threshold < 1))
     return absl::InvalidArgumentError("calibration: degeneracy_threshold must be in [0, 1)");
   if (!(s.coarse_search_deg >= 0 && s.coarse_search_deg <= 30) ||
       (s.coarse_search_deg > 0 && !(s.coarse_step_deg >= 0.1)) || s.coarse_points < 10)
     return absl::InvalidArgumentError(
         "calibration: coarse_search_deg in [0, 30], coarse_step_deg >= 0.1, coarse_points >= 10");
-  if (auto st = scan_in_sensor.Validate(); !st.ok()) return st;
-  CalibrationResult r;
-  r.scan_points = scan_in_sensor.CountValid();
-  const PointCloud* scan = &scan_in_sensor;
-  PointCloud filtered;
-  if (s.filter_outliers) {
-    auto clusters = ClusterLinks(scan_in_sensor, s.filter, cancel);
-    if (!clusters.ok()) return clusters.status();
-    auto cleaned = ApplyFilter(scan_in_sensor, *clusters);
-    if (!cleaned.ok()) return cleaned.status();
-    filtered = *std::move(cleaned);
-    r.filtered_points = clusters->removed;
-    scan = &filtered;
-  }
+  return absl::OkStatus();
+}
 
-  Eigen::Isometry3d initial_gauge_from_sensor =
-      world_from_gauge.inverse() * initial_world_from_sensor;
-  if (s.coarse_search_deg > 0) {
-    auto coarse = CoarseSearch(gauge, *scan, initial_gauge_from_sensor, s, cancel);
-    if (!coarse.ok()) return coarse.status();
-    r.coarse_rotation_deg = ComparePoses(initial_gauge_from_sensor, *coarse).rotation_deg;
-    initial_gauge_from_sensor = *coarse;
-  }
-  auto icp = RunIcp(gauge, *scan, initial_gauge_from_sensor, s.icp, cancel);
-  if (!icp.ok()) return icp.status();
-  r.icp = *std::move(icp);
-  r.gauge_from_sensor = r.icp.mesh_from_points;
-  r.world_from_sensor = world_from_gauge * r.gauge_from_sensor;
-
+// RMS, percentiles of |residual| and the inlier fraction of the final ICP.
+void SummarizeResiduals(CalibrationResult& r) {
   const std::vector<double>& res = r.icp.residuals_mm;
   double sum2 = 0;
   std::vector<double> abs_res;
@@ -160,13 +125,18 @@ absl::StatusOr<CalibrationResult> CalibrateViewpoint(
     sum2 += e * e;
     abs_res.push_back(std::abs(e));
   }
-  const double n = double(res.size());
-  r.rms_mm = std::sqrt(sum2 / n);
-  r.residual_p50_mm = Percentile(abs_res, 0.50);
-  r.residual_p95_mm = Percentile(abs_res, 0.95);
-  r.residual_p99_mm = Percentile(abs_res, 0.99);
+  r.rms_mm = std::sqrt(sum2 / double(res.size()));
+  if (!abs_res.empty()) {
+    Percentiles<double> p(abs_res);  // increasing q, as it requires
+    r.residual_p50_mm = p.At(0.50);
+    r.residual_p95_mm = p.At(0.95);
+    r.residual_p99_mm = p.At(0.99);
+  }
   r.inlier_fraction = double(r.icp.inliers) / double(r.icp.points_used);
+}
 
+// Degeneracy flag and the warnings a user should read.
+void Assess(const CalibrationSettings& s, CalibrationResult& r) {
   r.degeneracy_ratio = DegeneracyRatio(r.icp);
   r.degenerate = r.degeneracy_ratio < s.degeneracy_threshold;
   if (r.degenerate)
@@ -177,9 +147,16 @@ absl::StatusOr<CalibrationResult> CalibrateViewpoint(
                      "); rescan so that non-parallel surfaces are in view"));
   if (!r.icp.converged)
     r.warnings.push_back(absl::StrCat("ICP stopped at max_iterations (", r.icp.iterations, ")"));
+}
 
-  // Covariance σ² (JᵀJ)⁻¹ with σ² from the residuals (n - 6 dof). A singular
-  // normal matrix (degenerate scan) leaves the covariance unbounded.
+// Covariance σ² (JᵀJ)⁻¹ with σ² from the residuals (n - 6 dof), and its 1-σ
+// figures at the sensor origin. A singular normal matrix (degenerate scan)
+// leaves the covariance unbounded.
+void EstimateCovariance(CalibrationResult& r) {
+  const std::vector<double>& res = r.icp.residuals_mm;
+  double sum2 = 0;
+  for (double e : res) sum2 += e * e;
+  const double n = double(res.size());
   const Eigen::FullPivLU<Eigen::Matrix<double, 6, 6>> lu(r.icp.normal_matrix);
   if (n > 6 && lu.isInvertible()) {
     const double sigma2 = sum2 / (n - 6);
@@ -196,6 +173,45 @@ absl::StatusOr<CalibrationResult> CalibrateViewpoint(
     r.sigma_translation_um = INFINITY;
     r.sigma_rotation_deg = INFINITY;
   }
+}
+
+}  // namespace
+
+absl::StatusOr<CalibrationResult> CalibrateViewpoint(
+    const MeshIndex& gauge_in_gauge, const Eigen::Isometry3d& world_from_gauge,
+    const PointCloud& scan_in_sensor, const Eigen::Isometry3d& initial_world_from_sensor,
+    const CalibrationSettings& s, const std::atomic<bool>* cancel) {
+  if (auto st = CheckCalibrationSettings(s); !st.ok()) return st;
+  if (auto st = scan_in_sensor.Validate(); !st.ok()) return st;
+  CalibrationResult r;
+  r.scan_points = scan_in_sensor.CountValid();
+  const PointCloud* scan = &scan_in_sensor;
+  PointCloud filtered;
+  if (s.filter_outliers) {
+    filtered = scan_in_sensor;
+    LinkClusteringResult clusters;
+    if (auto st = RemoveOutliers(filtered, s.filter, clusters, cancel); !st.ok()) return st;
+    r.filtered_points = clusters.removed;
+    scan = &filtered;
+  }
+
+  Eigen::Isometry3d initial_gauge_from_sensor =
+      world_from_gauge.inverse() * initial_world_from_sensor;
+  if (s.coarse_search_deg > 0) {
+    auto coarse = CoarseSearch(gauge_in_gauge, *scan, initial_gauge_from_sensor, s, cancel);
+    if (!coarse.ok()) return coarse.status();
+    r.coarse_rotation_deg = ComparePoses(initial_gauge_from_sensor, *coarse).rotation_deg;
+    initial_gauge_from_sensor = *coarse;
+  }
+  auto icp = RunIcp(gauge_in_gauge, *scan, initial_gauge_from_sensor, s.icp, cancel);
+  if (!icp.ok()) return icp.status();
+  r.icp = *std::move(icp);
+  r.gauge_from_sensor = r.icp.mesh_from_points;
+  // The paper's eq. (1): world_from_sensor_i = world_from_gauge_i * gauge_from_sensor_i.
+  r.world_from_sensor = world_from_gauge * r.gauge_from_sensor;
+  SummarizeResiduals(r);
+  Assess(s, r);
+  EstimateCovariance(r);
   return r;
 }
 

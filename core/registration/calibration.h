@@ -56,7 +56,9 @@ struct CalibrationResult {
   std::size_t scan_points = 0;      // valid points in the scan
   std::size_t filtered_points = 0;  // removed by link clustering
   double rms_mm = 0;                // point-to-plane residual RMS of the inliers
-  double residual_p50_mm = 0, residual_p95_mm = 0, residual_p99_mm = 0;  // of |residual|
+  // Percentiles of |residual| (linear interpolation, core/types/percentile.h);
+  // 0 when there are no residuals.
+  double residual_p50_mm = 0, residual_p95_mm = 0, residual_p99_mm = 0;
   double inlier_fraction = 0;  // inliers / points used by ICP
   // Covariance of x = [ω (rad), t (mm)], the left perturbation of
   // gauge_from_sensor in the gauge frame: σ² (JᵀJ)⁻¹.

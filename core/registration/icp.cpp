@@ -13,22 +13,6 @@
 namespace surfinspect {
 namespace {
 
-absl::Status CheckSettings(const IcpSettings& s) {
-  if (s.max_iterations < 0 || s.max_iterations > 100000)
-    return absl::InvalidArgumentError("icp: max_iterations must be in 0..100000");
-  if (!(s.max_correspondence_mm > 0) || !(s.min_correspondence_mm > 0) ||
-      !std::isfinite(s.max_correspondence_mm) || s.min_correspondence_mm > s.max_correspondence_mm)
-    return absl::InvalidArgumentError(
-        "icp: need 0 < min_correspondence_mm <= max_correspondence_mm < inf");
-  if (!(s.trim_fraction >= 0 && s.trim_fraction < 0.9))
-    return absl::InvalidArgumentError("icp: trim_fraction must be in [0, 0.9)");
-  if (!(s.kernel_scale_mm > 0))
-    return absl::InvalidArgumentError("icp: kernel_scale_mm must be > 0");
-  if (!(s.relative_cost_tolerance >= 0) || !(s.absolute_cost_mm2 >= 0))
-    return absl::InvalidArgumentError("icp: tolerances must be >= 0");
-  return absl::OkStatus();
-}
-
 double KernelWeight(const IcpSettings& s, double r) {
   const double a = std::abs(r);
   switch (s.kernel) {
@@ -110,6 +94,7 @@ absl::StatusOr<Pairs> Correspond(const MeshIndex& mesh, const PointCloud& pts,
     out.w.push_back(KernelWeight(s, r));
     sum2 += c.distance_mm * c.distance_mm;
   }
+  // The paper's cost Δ_i of eq. (4), as a mean over the pairs (mm²).
   out.cost = out.p.empty() ? INFINITY : sum2 / out.p.size();
   return out;
 }
@@ -130,6 +115,7 @@ Eigen::Matrix<double, 6, 6> NormalMatrix(const Pairs& pr, Eigen::Matrix<double, 
 }
 
 absl::StatusOr<Eigen::Isometry3d> Step(const Pairs& pr, const IcpSettings& s) {
+  // Point-to-point: the T_i minimising eq. (4) in closed form (Horn's quaternion method).
   if (s.step == IcpStep::kPointToPoint) return HornAbsoluteOrientation(pr.p, pr.q, pr.w);
   Eigen::Matrix<double, 6, 1> b;
   const Eigen::Matrix<double, 6, 6> h = NormalMatrix(pr, &b);
@@ -148,6 +134,28 @@ absl::StatusOr<Eigen::Isometry3d> Step(const Pairs& pr, const IcpSettings& s) {
 
 }  // namespace
 
+absl::Status ValidateIcpSettings(const IcpSettings& s) {
+  auto bad = [](absl::string_view what, double v) {
+    return absl::InvalidArgumentError(absl::StrCat("icp: ", what, ", got ", v));
+  };
+  if (s.max_iterations < 0 || s.max_iterations > kMaxIcpIterations)
+    return bad(absl::StrCat("max_iterations must be in [0, ", kMaxIcpIterations, "]"),
+               s.max_iterations);
+  if (!(s.max_correspondence_mm > 0) || !std::isfinite(s.max_correspondence_mm))
+    return bad("max_correspondence_mm must be finite and > 0", s.max_correspondence_mm);
+  if (!(s.min_correspondence_mm > 0) || s.min_correspondence_mm > s.max_correspondence_mm)
+    return bad("min_correspondence_mm must be > 0 and <= max_correspondence_mm",
+               s.min_correspondence_mm);
+  if (!(s.trim_fraction >= 0 && s.trim_fraction < 0.9))
+    return bad("trim_fraction must be in [0, 0.9)", s.trim_fraction);
+  if (!(s.kernel_scale_mm > 0)) return bad("kernel_scale_mm must be > 0", s.kernel_scale_mm);
+  if (!(s.relative_cost_tolerance >= 0) || !std::isfinite(s.relative_cost_tolerance))
+    return bad("relative_cost_tolerance must be finite and >= 0", s.relative_cost_tolerance);
+  if (!(s.absolute_cost_mm2 >= 0))
+    return bad("absolute_cost_mm2 must be >= 0", s.absolute_cost_mm2);
+  return absl::OkStatus();
+}
+
 const char* ToString(IcpStopReason reason) {
   switch (reason) {
     case IcpStopReason::kRelativeChange:
@@ -161,18 +169,18 @@ const char* ToString(IcpStopReason reason) {
 }
 
 absl::StatusOr<IcpResult> RunIcp(const MeshIndex& mesh, const PointCloud& points,
-                                 const Eigen::Isometry3d& initial, const IcpSettings& s,
-                                 const std::atomic<bool>* cancel) {
-  if (auto st = CheckSettings(s); !st.ok()) return st;
+                                 const Eigen::Isometry3d& initial_mesh_from_points,
+                                 const IcpSettings& s, const std::atomic<bool>* cancel) {
+  if (auto st = ValidateIcpSettings(s); !st.ok()) return st;
   if (auto st = points.Validate(); !st.ok()) return st;
-  if (!initial.matrix().allFinite())
+  if (!initial_mesh_from_points.matrix().allFinite())
     return absl::InvalidArgumentError("icp: initial pose is not finite");
   const PointCloud pts = Subsample(points, s.max_points, s.seed);
   if (pts.size() < 6) return absl::InvalidArgumentError("icp: fewer than 6 valid points");
 
   IcpResult result;
   result.points_used = pts.size();
-  Eigen::Isometry3d pose = initial;
+  Eigen::Isometry3d pose = initial_mesh_from_points;
   double gate = s.max_correspondence_mm, previous_gate = gate;
   for (int it = 0;; ++it) {
     if (IsCancelled(cancel)) return absl::CancelledError("icp cancelled");
@@ -193,6 +201,9 @@ absl::StatusOr<IcpResult> RunIcp(const MeshIndex& mesh, const PointCloud& points
       result.stop_reason = IcpStopReason::kAbsoluteCost;
       stop = true;
     } else if (it >= 1) {
+      // The paper's eq. (5): δ = (Δ_i − Δ_{i−1}) / (Δ_{i−1} − Δ_{i−2}), here
+      // as the ratio of successive decreases; the gain still to come is the
+      // geometric tail (Δ_{i−1} − Δ_i)·δ/(1 − δ).
       const double dec1 = h[it - 1] - h[it];
       const double delta =
           it >= 2 && h[it - 2] - h[it - 1] > 0 ? dec1 / (h[it - 2] - h[it - 1]) : -1;

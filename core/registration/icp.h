@@ -35,9 +35,13 @@ enum class RobustKernel { kNone, kHuber, kTukey };
 enum class IcpStopReason { kRelativeChange, kAbsoluteCost, kMaxIterations };
 const char* ToString(IcpStopReason reason);
 
+// Bounds the work of one ICP run: each iteration is a closest-point pass
+// over up to max_points points, and the server runs ICP for remote callers.
+constexpr int kMaxIcpIterations = 10000;
+
 struct IcpSettings {
   IcpStep step = IcpStep::kPointToPoint;  // the paper's step
-  int max_iterations = 100;
+  int max_iterations = 100;               // in [0, kMaxIcpIterations]
   // Pairs farther apart than the gate are rejected. The gate starts at
   // `max_correspondence_mm` (must cover the initial pose error) and then
   // follows 4 x the previous RMS, never below `min_correspondence_mm`.
@@ -70,6 +74,10 @@ struct IcpResult {
   Eigen::Vector3d inlier_centroid = Eigen::Vector3d::Zero();  // mesh frame, mm
   double inlier_radius_mm = 0;  // RMS distance of the inliers from their centroid
 };
+
+// Checks the settings: InvalidArgument naming the bad field. RunIcp, the
+// wire conversion, the CLI and the cell file all use it.
+absl::Status ValidateIcpSettings(const IcpSettings& settings);
 
 // Fails with InvalidArgument for bad settings or fewer than 6 valid points,
 // FailedPrecondition when too few pairs fall inside the gate (initial pose

@@ -5,6 +5,17 @@
 
 namespace surfinspect {
 
+absl::Status FilterViews(std::vector<ViewScan>& views, const LinkClusteringSettings& settings,
+                         const std::atomic<bool>* cancel, const FilteredViewSink& on_view) {
+  LinkClusteringResult clusters;  // buffers reused across views
+  for (ViewScan& v : views) {
+    if (auto st = RemoveOutliers(v.cloud_in_sensor, settings, clusters, cancel); !st.ok())
+      return absl::Status(st.code(), absl::StrCat("view '", v.name, "': ", st.message()));
+    if (on_view) on_view(v, clusters);
+  }
+  return absl::OkStatus();
+}
+
 absl::StatusOr<MergedCloud> RegisterToWorld(const std::vector<ViewScan>& views) {
   if (views.empty()) return absl::InvalidArgumentError("register: no views");
   if (views.size() > 65535) return absl::InvalidArgumentError("register: more than 65535 views");
@@ -28,6 +39,7 @@ absl::StatusOr<MergedCloud> RegisterToWorld(const std::vector<ViewScan>& views) 
     const ViewScan& v = views[k];
     out.view_names.push_back(v.name);
     const std::size_t before = pts.size();
+    // Each point through the calibrated pose of the paper's eq. (1).
     v.cloud_in_sensor.ForEachValid([&](std::size_t i, const Eigen::Vector3f& p) {
       pts.push_back((v.world_from_sensor * p.cast<double>()).cast<float>());
       out.view_id.push_back(static_cast<uint16_t>(k));

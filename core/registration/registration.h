@@ -11,11 +11,13 @@
 
 #include <Eigen/Geometry>
 #include <atomic>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
 #include "core/distance/mesh_index.h"
+#include "core/filter/link_clustering.h"
 #include "core/registration/icp.h"
 #include "core/types/point_cloud.h"
 
@@ -34,6 +36,16 @@ struct MergedCloud {
   std::vector<std::string> view_names;
   std::vector<std::size_t> points_per_view;
 };
+
+// Link-clustering filter of every view's cloud, in place (RemoveOutliers),
+// before RegisterToWorld. `on_view`, when given, sees each view with its
+// clustering right after it is filtered. Errors as ClusterLinks, prefixed
+// with the view's name.
+using FilteredViewSink =
+    std::function<void(const ViewScan& view, const LinkClusteringResult& clusters)>;
+absl::Status FilterViews(std::vector<ViewScan>& views, const LinkClusteringSettings& settings,
+                         const std::atomic<bool>* cancel = nullptr,
+                         const FilteredViewSink& on_view = nullptr);
 
 // Fails on an invalid cloud, a non-rigid transform, or more than 65535 views.
 absl::StatusOr<MergedCloud> RegisterToWorld(const std::vector<ViewScan>& views);

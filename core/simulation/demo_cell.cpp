@@ -1,15 +1,9 @@
 #include "core/simulation/demo_cell.h"
 
-#include <filesystem>
-#include <nlohmann/json.hpp>
 #include <random>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "core/io/atomic_file.h"
-#include "core/io/io_mesh.h"
-#include "core/io/io_point_cloud.h"
-#include "core/io/io_transform.h"
 #include "core/types/transform.h"
 
 namespace surfinspect {
@@ -180,104 +174,47 @@ DemoCell MakeDemoCell(const DemoCellOptions& o) {
   return cell;
 }
 
-absl::Status WriteDemoCell(const std::string& dir, const DemoCell& cell,
-                           const DemoWriteOptions& options) {
-  std::error_code ec;
-  for (const char* sub : {"", "/gauge_scans", "/scans", "/truth"})
-    if (std::filesystem::create_directories(dir + sub, ec); ec)
-      return absl::PermissionDeniedError(absl::StrCat(dir, sub, ": ", ec.message()));
-  if (auto st = WriteMesh(dir + "/part.stl", cell.part); !st.ok()) return st;
-  if (auto st = WriteMesh(dir + "/gauge.stl", cell.gauge); !st.ok()) return st;
-
-  nlohmann::json views = nlohmann::json::array();
-  for (std::size_t v = 0; v < cell.viewpoints.size(); ++v) {
-    const DemoViewpoint& vp = cell.viewpoints[v];
-    ScanOptions gauge_opt = options.scan;
-    gauge_opt.defects.clear();
-    gauge_opt.seed = options.scan.seed * 1000 + v;
-    auto gauge_scan = SimulateScan(cell.gauge, vp.world_from_gauge, vp.world_from_sensor,
-                                   cell.intrinsics, gauge_opt);
-    if (!gauge_scan.ok()) return gauge_scan.status();
-    const std::string gauge_path = absl::StrCat("gauge_scans/", vp.name, ".pcd");
-    if (auto st = WritePointCloud(dir + "/" + gauge_path, gauge_scan->cloud_in_sensor); !st.ok())
-      return st;
-    views.push_back(
-        {{"name", vp.name},
-         {"nominal_world_from_sensor", TransformToJsonValue(vp.nominal_world_from_sensor)},
-         {"world_from_gauge", TransformToJsonValue(vp.world_from_gauge)},
-         {"gauge_scan", gauge_path},
-         {"simulation_truth_world_from_sensor", TransformToJsonValue(vp.world_from_sensor)}});
-  }
-
-  std::mt19937_64 rng(options.scan.seed + 7);
+std::vector<DemoPart> MakeDemoParts(const DemoCell& cell, int count, uint64_t scan_seed) {
+  std::mt19937_64 rng(scan_seed + 7);
   std::uniform_real_distribution<double> ux(-0.45, 0.45), uy(-18, 18), udepth(0.05, 0.5),
       uradius(3, 8);
-  const double length = ComputeBounds(cell.part).max.x() - ComputeBounds(cell.part).min.x();
-  nlohmann::json parts = nlohmann::json::array();
-  for (int k = 1; k <= options.parts; ++k) {
-    const std::string part_id = absl::StrFormat("part-%03d", k);
-    ScanOptions opt = options.scan;
-    nlohmann::json defects = nlohmann::json::array();
+  const Bounds3 bounds = ComputeBounds(cell.part);
+  const double length = bounds.max.x() - bounds.min.x();
+  std::vector<DemoPart> parts;
+  for (int k = 1; k <= count; ++k) {
+    DemoPart part;
+    part.number = k;
+    part.part_id = absl::StrFormat("part-%03d", k);
     for (int d = 0; d < 3; ++d) {
       SurfaceDefect defect;
       const double x = ux(rng) * length;
       defect.center_in_part = {x, uy(rng), RidgeZ(x, length)};
       defect.radius_mm = uradius(rng);
       defect.depth_mm = (d == 2 ? -1 : 1) * udepth(rng);  // two dents and a bump
-      opt.defects.push_back(defect);
-      defects.push_back(
-          {{"center_in_part", {x, defect.center_in_part.y(), defect.center_in_part.z()}},
-           {"radius_mm", defect.radius_mm},
-           {"depth_mm", defect.depth_mm}});
+      part.defects.push_back(defect);
     }
-    std::filesystem::create_directories(absl::StrCat(dir, "/scans/", part_id), ec);
-    std::filesystem::create_directories(absl::StrCat(dir, "/truth/", part_id), ec);
-    nlohmann::json scans = nlohmann::json::object();
-    for (std::size_t v = 0; v < cell.viewpoints.size(); ++v) {
-      const DemoViewpoint& vp = cell.viewpoints[v];
-      opt.seed = options.scan.seed * 7919 + k * 100 + v;
-      auto scan =
-          SimulateScan(cell.part, cell.world_from_part, vp.world_from_sensor, cell.intrinsics, opt);
-      if (!scan.ok()) return scan.status();
-      const std::string path = absl::StrCat(dir, "/scans/", part_id, "/", vp.name, ".pcd");
-      if (auto st = WritePointCloud(path, scan->cloud_in_sensor); !st.ok()) return st;
-      nlohmann::json pulses = nlohmann::json::array(), stripes = nlohmann::json::array();
-      for (std::size_t i = 0; i < scan->labels.size(); ++i) {
-        if (scan->labels[i] == PixelLabel::kPulse) pulses.push_back(i);
-        if (scan->labels[i] == PixelLabel::kStripe) stripes.push_back(i);
-      }
-      const nlohmann::json truth = {
-          {"part_id", part_id},         {"viewpoint", vp.name},
-          {"valid_points", scan->hits}, {"pulse_pixels", pulses},
-          {"stripe_pixels", stripes},   {"defect_pixels", scan->defect_pixels}};
-      if (auto st = WriteStringAtomically(
-              absl::StrCat(dir, "/truth/", part_id, "/", vp.name, ".json"), truth.dump());
-          !st.ok())
-        return st;
-      scans[vp.name] = absl::StrCat("scans/", part_id, "/", vp.name, ".pcd");
-    }
-    parts.push_back({{"part_id", part_id}, {"defects", defects}, {"scans", scans}});
+    parts.push_back(std::move(part));
   }
+  return parts;
+}
 
-  const nlohmann::json cell_json = {
-      {"units", "mm"},
-      {"part",
-       {{"mesh", "part.stl"}, {"world_from_part", TransformToJsonValue(cell.world_from_part)}}},
-      {"gauge", {{"mesh", "gauge.stl"}}},
-      {"sensor",
-       {{"width", cell.intrinsics.width},
-        {"height", cell.intrinsics.height},
-        {"horizontal_fov_deg", cell.intrinsics.horizontal_fov_deg},
-        {"min_range_mm", cell.intrinsics.min_range_mm},
-        {"max_range_mm", cell.intrinsics.max_range_mm}}},
-      {"viewpoints", views},
-      // Stamped sheet metal: +-0.3 mm, and 0.1% of the points may fall
-      // outside (unfiltered speckle at shadow edges) before a part fails.
-      {"tolerance_mm", 0.3},
-      {"error_map", {{"allowed_fraction_outside", 0.001}, {"max_distance_mm", 5.0}}}};
-  if (auto st = WriteStringAtomically(dir + "/cell.json", cell_json.dump(2) + "\n"); !st.ok())
-    return st;
-  return WriteStringAtomically(dir + "/truth/parts.json", nlohmann::json(parts).dump(2) + "\n");
+absl::StatusOr<SimulatedScan> SimulateDemoGaugeScan(const DemoCell& cell, std::size_t v,
+                                                    const ScanOptions& scan) {
+  const DemoViewpoint& vp = cell.viewpoints.at(v);
+  ScanOptions gauge_opt = scan;
+  gauge_opt.defects.clear();
+  gauge_opt.seed = scan.seed * 1000 + v;
+  return SimulateScan(cell.gauge, vp.world_from_gauge, vp.world_from_sensor, cell.intrinsics,
+                      gauge_opt);
+}
+
+absl::StatusOr<SimulatedScan> SimulateDemoPartScan(const DemoCell& cell, const DemoPart& part,
+                                                   std::size_t v, const ScanOptions& scan) {
+  const DemoViewpoint& vp = cell.viewpoints.at(v);
+  ScanOptions opt = scan;
+  opt.defects.insert(opt.defects.end(), part.defects.begin(), part.defects.end());
+  opt.seed = scan.seed * 7919 + part.number * 100 + v;
+  return SimulateScan(cell.part, cell.world_from_part, vp.world_from_sensor, cell.intrinsics, opt);
 }
 
 }  // namespace surfinspect

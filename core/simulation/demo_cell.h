@@ -2,7 +2,8 @@
 // hat-channel profile ~300 mm long with flanges and bends, a few thousand
 // triangles, outward CCW normals), a 6-DOF calibration gauge (a stepped plate
 // with spheres of different radii), and five viewpoints ~400 mm above the
-// part's top ridge. Nothing is read from disk; everything is generated.
+// part's top ridge. Nothing is read from disk; everything is generated
+// (client/cell/demo_cell_files.h writes it as a cell folder).
 //
 // Calibration follows the paper's eq. (1): for viewpoint i the gauge sits at
 // its own surveyed pose `world_from_gauge` under that viewpoint, so
@@ -13,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "absl/status/status.h"
+#include "absl/status/statusor.h"
 #include "core/simulation/scan_simulator.h"
 #include "core/types/triangle_mesh.h"
 
@@ -49,14 +50,25 @@ TriangleMesh MakePillarMesh(double length_mm = 300.0);
 // The calibration gauge alone (plate in z <= 0, spheres and steps above).
 TriangleMesh MakeGaugeMesh();
 
-// Writes DIR/{part.stl, gauge.stl, cell.json, scans/, gauge_scans/, truth/}:
-// for each viewpoint a gauge scan and `parts` production scans with planted
-// defects (organized binary PCD) and their ground truth as JSON.
-struct DemoWriteOptions {
-  int parts = 1;
-  ScanOptions scan;  // noise/outliers for production scans; defects are added
+// A production part of the demo: its id and the defects planted on it.
+struct DemoPart {
+  int number = 1;                      // 1-based
+  std::string part_id;                 // "part-001", ...
+  std::vector<SurfaceDefect> defects;  // two dents and a bump on the ridge
 };
-absl::Status WriteDemoCell(const std::string& dir, const DemoCell& cell,
-                           const DemoWriteOptions& options);
+
+// Parts 1..count with their defects, drawn from `scan_seed` (the seed of the
+// production scans' ScanOptions).
+std::vector<DemoPart> MakeDemoParts(const DemoCell& cell, int count, uint64_t scan_seed);
+
+// The gauge scan of viewpoint v (index into cell.viewpoints): `scan`'s noise
+// and outliers without defects, seeded by scan.seed and v.
+absl::StatusOr<SimulatedScan> SimulateDemoGaugeScan(const DemoCell& cell, std::size_t v,
+                                                    const ScanOptions& scan);
+
+// The production scan of `part` from viewpoint v: `scan` plus the part's
+// defects, seeded by scan.seed, the part's number and v.
+absl::StatusOr<SimulatedScan> SimulateDemoPartScan(const DemoCell& cell, const DemoPart& part,
+                                                   std::size_t v, const ScanOptions& scan);
 
 }  // namespace surfinspect

@@ -2,7 +2,8 @@
 // part mesh with Embree and returns the organized cloud it would measure, in
 // the SENSOR frame, in millimetres, with NaN where nothing valid is seen.
 // Every imperfection is seeded and deterministic, and each pixel carries its
-// ground truth so later steps (filter, calibration, error map) can be scored.
+// ground truth, so the filter, the calibration and the error map can be
+// scored against it.
 //
 // Sensor frame: +z along the optical axis (viewing direction), +x to the
 // right in the image, +y down the image (rows), as in OpenCV.

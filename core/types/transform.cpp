@@ -14,11 +14,12 @@ RowMajor16 ToRowMajor(const Eigen::Isometry3d& t) {
   return out;
 }
 
-absl::StatusOr<Eigen::Isometry3d> FromRowMajor(const RowMajor16& v, absl::string_view what) {
+absl::StatusOr<Eigen::Isometry3d> FromRowMajor(const RowMajor16& row_major,
+                                               absl::string_view what) {
   Eigen::Matrix4d m;
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) {
-      const double x = v[r * 4 + c];
+      const double x = row_major[r * 4 + c];
       if (!std::isfinite(x))
         return absl::InvalidArgumentError(
             absl::StrCat(what, ": element (", r, ",", c, ") is not finite"));

@@ -21,7 +21,7 @@ RowMajor16 ToRowMajor(const Eigen::Isometry3d& t);
 // rotation off by more than 1e-12 (e.g. printed with few digits) is
 // re-orthonormalised; otherwise the matrix is kept bit for bit. `what` names the transform in the
 // error message.
-absl::StatusOr<Eigen::Isometry3d> FromRowMajor(const RowMajor16& m, absl::string_view what);
+absl::StatusOr<Eigen::Isometry3d> FromRowMajor(const RowMajor16& row_major, absl::string_view what);
 
 // Applies `to_from` to every valid point; NaN pixels stay NaN, so an
 // organized grid stays organized. Computed in double, stored as float.

@@ -62,20 +62,5 @@ TEST(DemoCell, FiveViewpointsSeeTheRidgeAndTheirGauges) {
   }
 }
 
-TEST(DemoCell, WritesEveryFile) {
-  testing::TempDir dir;
-  DemoWriteOptions opt;
-  opt.parts = 1;
-  opt.scan.pulse_fraction = 0.003;
-  ASSERT_TRUE(WriteDemoCell(dir.path(), MakeDemoCell(), opt).ok());
-  for (const char* f : {"part.stl", "gauge.stl", "cell.json", "truth/parts.json",
-                        "gauge_scans/v1.pcd", "scans/part-001/v5.pcd", "truth/part-001/v3.json"})
-    EXPECT_TRUE(std::filesystem::exists(dir.File(f))) << f;
-  auto scan = ReadPointCloud(dir.File("scans/part-001/v1.pcd"));
-  ASSERT_TRUE(scan.ok());
-  EXPECT_EQ(scan->width, 1024u);
-  EXPECT_EQ(scan->height, 768u);
-}
-
 }  // namespace
 }  // namespace surfinspect

@@ -1,0 +1,126 @@
+#include "client/cell/demo_cell_files.h"
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <system_error>
+
+#include "absl/strings/str_cat.h"
+#include "core/io/atomic_file.h"
+#include "core/io/io_mesh.h"
+#include "core/io/io_point_cloud.h"
+#include "core/io/io_transform.h"
+
+namespace surfinspect::client {
+namespace {
+
+absl::Status MakeDirectory(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::create_directories(path, ec); ec)
+    return absl::PermissionDeniedError(absl::StrCat(path, ": ", ec.message()));
+  return absl::OkStatus();
+}
+
+// Writes the gauge scans; returns cell.json's "viewpoints" array.
+absl::StatusOr<nlohmann::json> WriteGaugeScans(const std::string& dir, const DemoCell& cell,
+                                               const ScanOptions& scan) {
+  nlohmann::json views = nlohmann::json::array();
+  for (std::size_t v = 0; v < cell.viewpoints.size(); ++v) {
+    const DemoViewpoint& vp = cell.viewpoints[v];
+    auto gauge_scan = SimulateDemoGaugeScan(cell, v, scan);
+    if (!gauge_scan.ok()) return gauge_scan.status();
+    const std::string gauge_path = absl::StrCat("gauge_scans/", vp.name, ".pcd");
+    if (auto st = WritePointCloud(dir + "/" + gauge_path, gauge_scan->cloud_in_sensor); !st.ok())
+      return st;
+    views.push_back(
+        {{"name", vp.name},
+         {"nominal_world_from_sensor", TransformToJsonValue(vp.nominal_world_from_sensor)},
+         {"world_from_gauge", TransformToJsonValue(vp.world_from_gauge)},
+         {"gauge_scan", gauge_path},
+         {"simulation_truth_world_from_sensor", TransformToJsonValue(vp.world_from_sensor)}});
+  }
+  return views;
+}
+
+// The outlier pixels of one production scan, as truth/PART/VIEW.json holds them.
+nlohmann::json ScanTruth(const std::string& part_id, const std::string& view,
+                         const SimulatedScan& scan) {
+  nlohmann::json pulses = nlohmann::json::array(), stripes = nlohmann::json::array();
+  for (std::size_t i = 0; i < scan.labels.size(); ++i) {
+    if (scan.labels[i] == PixelLabel::kPulse) pulses.push_back(i);
+    if (scan.labels[i] == PixelLabel::kStripe) stripes.push_back(i);
+  }
+  return {{"part_id", part_id},        {"viewpoint", view},
+          {"valid_points", scan.hits}, {"pulse_pixels", pulses},
+          {"stripe_pixels", stripes},  {"defect_pixels", scan.defect_pixels}};
+}
+
+// Writes one part's scans and truth; returns its entry of truth/parts.json.
+absl::StatusOr<nlohmann::json> WritePart(const std::string& dir, const DemoCell& cell,
+                                         const DemoPart& part, const ScanOptions& scan) {
+  nlohmann::json defects = nlohmann::json::array();
+  for (const SurfaceDefect& d : part.defects)
+    defects.push_back(
+        {{"center_in_part", {d.center_in_part.x(), d.center_in_part.y(), d.center_in_part.z()}},
+         {"radius_mm", d.radius_mm},
+         {"depth_mm", d.depth_mm}});
+  for (const char* sub : {"/scans/", "/truth/"})
+    if (auto st = MakeDirectory(absl::StrCat(dir, sub, part.part_id)); !st.ok()) return st;
+  nlohmann::json scans = nlohmann::json::object();
+  for (std::size_t v = 0; v < cell.viewpoints.size(); ++v) {
+    const std::string& view = cell.viewpoints[v].name;
+    auto s = SimulateDemoPartScan(cell, part, v, scan);
+    if (!s.ok()) return s.status();
+    const std::string path = absl::StrCat("scans/", part.part_id, "/", view, ".pcd");
+    if (auto st = WritePointCloud(dir + "/" + path, s->cloud_in_sensor); !st.ok()) return st;
+    if (auto st =
+            WriteStringAtomically(absl::StrCat(dir, "/truth/", part.part_id, "/", view, ".json"),
+                                  ScanTruth(part.part_id, view, *s).dump());
+        !st.ok())
+      return st;
+    scans[view] = path;
+  }
+  return nlohmann::json{{"part_id", part.part_id}, {"defects", defects}, {"scans", scans}};
+}
+
+nlohmann::json CellJson(const DemoCell& cell, nlohmann::json views) {
+  return {{"units", "mm"},
+          {"part",
+           {{"mesh", "part.stl"}, {"world_from_part", TransformToJsonValue(cell.world_from_part)}}},
+          {"gauge", {{"mesh", "gauge.stl"}}},
+          {"sensor",
+           {{"width", cell.intrinsics.width},
+            {"height", cell.intrinsics.height},
+            {"horizontal_fov_deg", cell.intrinsics.horizontal_fov_deg},
+            {"min_range_mm", cell.intrinsics.min_range_mm},
+            {"max_range_mm", cell.intrinsics.max_range_mm}}},
+          {"viewpoints", std::move(views)},
+          // Stamped sheet metal: +-0.3 mm, and 0.1% of the points may fall
+          // outside (unfiltered speckle at shadow edges) before a part fails.
+          {"tolerance_mm", 0.3},
+          {"error_map", {{"allowed_fraction_outside", 0.001}, {"max_distance_mm", 5.0}}}};
+}
+
+}  // namespace
+
+absl::Status WriteDemoCell(const std::string& dir, const DemoCell& cell,
+                           const DemoWriteOptions& options) {
+  for (const char* sub : {"", "/gauge_scans", "/scans", "/truth"})
+    if (auto st = MakeDirectory(dir + sub); !st.ok()) return st;
+  if (auto st = WriteMesh(dir + "/part.stl", cell.part); !st.ok()) return st;
+  if (auto st = WriteMesh(dir + "/gauge.stl", cell.gauge); !st.ok()) return st;
+  auto views = WriteGaugeScans(dir, cell, options.scan);
+  if (!views.ok()) return views.status();
+  nlohmann::json parts = nlohmann::json::array();
+  for (const DemoPart& part : MakeDemoParts(cell, options.parts, options.scan.seed)) {
+    auto entry = WritePart(dir, cell, part, options.scan);
+    if (!entry.ok()) return entry.status();
+    parts.push_back(*std::move(entry));
+  }
+  if (auto st = WriteStringAtomically(dir + "/cell.json",
+                                      CellJson(cell, *std::move(views)).dump(2) + "\n");
+      !st.ok())
+    return st;
+  return WriteStringAtomically(dir + "/truth/parts.json", nlohmann::json(parts).dump(2) + "\n");
+}
+
+}  // namespace surfinspect::client

@@ -1,0 +1,31 @@
+// The one percentile definition of the reports: NumPy's default "linear"
+// rule. For n sorted values v[0..n-1] and q in [0, 1], with pos = q (n - 1),
+//     P(q) = v[floor(pos)] + (pos - floor(pos)) (v[floor(pos) + 1] - v[floor(pos)]),
+// and P(q) = v[n - 1] at the top. The error map's p1..p99 and the
+// calibration's residual p50/p95/p99 both use it.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+namespace surfinspect {
+
+// Percentiles of one vector, by partial selection (O(n) per call, no full
+// sort). Reorders the vector it is given; calls must come in increasing q,
+// so each selection works only on the tail the previous one left.
+template <typename T>
+class Percentiles {
+ public:
+  explicit Percentiles(std::vector<T>& values) : v_(values) {}
+  // P(q) as above; NaN for an empty vector.
+  double At(double q);
+
+ private:
+  std::vector<T>& v_;
+  std::size_t done_ = 0;
+};
+
+extern template class Percentiles<float>;
+extern template class Percentiles<double>;
+
+}  // namespace surfinspect

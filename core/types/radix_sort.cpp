@@ -1,0 +1,37 @@
+#include "core/types/radix_sort.h"
+
+#include <algorithm>
+#include <cstddef>
+#include <utility>
+
+#include "core/types/cancel.h"
+
+namespace surfinspect {
+
+bool RadixSortPairs(std::vector<uint64_t>& keys, std::vector<uint32_t>& values, int key_bits,
+                    const std::atomic<bool>* cancel) {
+  constexpr int kDigitBits = 11;
+  constexpr std::size_t kBuckets = std::size_t{1} << kDigitBits;
+  constexpr std::size_t kCancelStride = std::size_t{1} << 16;
+  if (key_bits <= 0) return !IsCancelled(cancel);
+  std::vector<uint64_t> keys_tmp(keys.size());
+  std::vector<uint32_t> values_tmp(values.size());
+  std::vector<std::size_t> start(kBuckets);
+  for (int shift = 0; shift < key_bits; shift += kDigitBits) {
+    std::fill(start.begin(), start.end(), 0);
+    for (uint64_t k : keys) ++start[(k >> shift) & (kBuckets - 1)];
+    std::size_t sum = 0;
+    for (auto& s : start) sum += std::exchange(s, sum);
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+      if (i % kCancelStride == 0 && IsCancelled(cancel)) return false;
+      const std::size_t to = start[(keys[i] >> shift) & (kBuckets - 1)]++;
+      keys_tmp[to] = keys[i];
+      values_tmp[to] = values[i];
+    }
+    keys.swap(keys_tmp);
+    values.swap(values_tmp);
+  }
+  return true;
+}
+
+}  // namespace surfinspect

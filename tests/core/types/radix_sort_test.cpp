@@ -1,0 +1,48 @@
+// core/types/radix_sort.cpp against std::stable_sort.
+#include "core/types/radix_sort.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <numeric>
+#include <random>
+#include <vector>
+
+namespace surfinspect {
+namespace {
+
+TEST(RadixSort, MatchesStableSortForEveryKeyWidth) {
+  std::mt19937_64 rng(3);
+  for (int key_bits : {1, 5, 11, 12, 22, 31, 33, 63}) {
+    for (std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{17}, std::size_t{5000}}) {
+      // Few distinct keys at small widths, so ties (and stability) matter.
+      const uint64_t mask = key_bits == 64 ? ~uint64_t{0} : (uint64_t{1} << key_bits) - 1;
+      std::vector<uint64_t> keys(n);
+      for (auto& k : keys) k = rng() & mask;
+      std::vector<uint32_t> values(n);
+      std::iota(values.begin(), values.end(), 0u);
+      std::vector<uint32_t> expected = values;
+      std::stable_sort(expected.begin(), expected.end(),
+                       [&](uint32_t a, uint32_t b) { return keys[a] < keys[b]; });
+      std::vector<uint64_t> expected_keys(n);
+      for (std::size_t i = 0; i < n; ++i) expected_keys[i] = keys[expected[i]];
+      ASSERT_TRUE(RadixSortPairs(keys, values, key_bits));
+      EXPECT_EQ(values, expected) << key_bits << " bits, n " << n;
+      EXPECT_EQ(keys, expected_keys) << key_bits << " bits, n " << n;
+    }
+  }
+}
+
+TEST(RadixSort, StopsWhenCancelled) {
+  std::vector<uint64_t> keys = {3, 1, 2};
+  std::vector<uint32_t> values = {0, 1, 2};
+  std::atomic<bool> cancel{true};
+  EXPECT_FALSE(RadixSortPairs(keys, values, 2, &cancel));
+  cancel = false;
+  EXPECT_TRUE(RadixSortPairs(keys, values, 2, &cancel));
+  EXPECT_EQ(values, (std::vector<uint32_t>{1, 2, 0}));
+}
+
+}  // namespace
+}  // namespace surfinspect
