@@ -1,0 +1,316 @@
+#include "core/io/pcd_format.h"
+
+#include <cstring>
+#include <limits>
+#include <map>
+
+#include "absl/strings/str_cat.h"
+#include "core/io/lzf.h"
+#include "core/io/text_parse.h"
+
+namespace surfinspect {
+namespace {
+
+constexpr std::size_t kMaxHeaderBytes = 64 * 1024;
+constexpr uint64_t kMaxFieldCount = 4096;
+
+using Entries = std::map<std::string, std::vector<std::string_view>>;
+
+bool KnownKey(std::string_view key) {
+  for (const char* k : {"VERSION", "FIELDS", "SIZE", "TYPE", "COUNT", "WIDTH", "HEIGHT",
+                        "VIEWPOINT", "POINTS", "DATA"})
+    if (key == k) return true;
+  return false;
+}
+
+// Collects "KEY values..." lines up to and including DATA; comments (#) and
+// blank lines are skipped, anything else must be a known key, once.
+absl::Status ReadEntries(std::string_view bytes, std::string_view name, Entries* entries,
+                         std::size_t* data_offset) {
+  LineScanner lines(bytes);
+  std::string_view line;
+  std::vector<std::string_view> tok;
+  while (lines.Next(&line)) {
+    if (lines.pos() > kMaxHeaderBytes) return BadFile(name, "header too long or missing its end");
+    if (IsBlank(line) || line[0] == '#') continue;
+    SplitWhitespace(line, &tok);
+    std::string key(tok[0]);
+    if (key == "COLUMNS") key = "FIELDS";  // PCL's older spelling
+    if (!KnownKey(key))
+      return BadFile(name, absl::StrCat("PCD header line ", lines.line_number(), ": unknown key '",
+                                        Excerpt(tok[0]), "'"));
+    if (entries->count(key))
+      return BadFile(name, absl::StrCat("PCD header line ", lines.line_number(), ": repeated key ",
+                                        key));
+    (*entries)[key].assign(tok.begin() + 1, tok.end());
+    if (key == "DATA") {
+      *data_offset = lines.pos();
+      return absl::OkStatus();
+    }
+  }
+  return BadFile(name, "truncated header: no 'DATA' line");
+}
+
+absl::Status CheckSimpleEntries(const Entries& e, std::string_view name) {
+  if (auto it = e.find("VERSION"); it != e.end()) {
+    double v = 0;
+    if (it->second.size() != 1 || !ParseDouble(it->second[0], &v))
+      return BadFile(name, "PCD header: bad VERSION");
+  }
+  if (auto it = e.find("VIEWPOINT"); it != e.end()) {
+    double v = 0;
+    bool ok = it->second.size() == 7;
+    for (std::size_t i = 0; ok && i < 7; ++i) ok = ParseDouble(it->second[i], &v);
+    if (!ok) return BadFile(name, "PCD header: VIEWPOINT needs 7 numbers");
+  }
+  return absl::OkStatus();
+}
+
+absl::Status BuildFields(const Entries& e, std::string_view name, PcdHeader* h) {
+  const auto& fields = e.at("FIELDS");
+  const auto& sizes = e.at("SIZE");
+  const auto& types = e.at("TYPE");
+  const auto count_it = e.find("COUNT");
+  if (fields.empty()) return BadFile(name, "PCD header: FIELDS is empty");
+  if (sizes.size() != fields.size() || types.size() != fields.size() ||
+      (count_it != e.end() && count_it->second.size() != fields.size()))
+    return BadFile(name, "PCD header: FIELDS, SIZE, TYPE and COUNT disagree in length");
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    PcdField f;
+    f.name = std::string(fields[i]);
+    uint64_t size = 0, count = 1;
+    if (!ParseUint(sizes[i], &size) || !(size == 1 || size == 2 || size == 4 || size == 8))
+      return BadFile(name, absl::StrCat("PCD header: bad SIZE for field ", Excerpt(f.name)));
+    if (types[i].size() != 1 || std::string_view("FIU").find(types[i][0]) == std::string::npos ||
+        (types[i][0] == 'F' && size != 4 && size != 8))
+      return BadFile(name, absl::StrCat("PCD header: bad TYPE for field ", Excerpt(f.name)));
+    if (count_it != e.end() &&
+        (!ParseUint(count_it->second[i], &count) || count == 0 || count > kMaxFieldCount))
+      return BadFile(name, absl::StrCat("PCD header: bad COUNT for field ", Excerpt(f.name)));
+    for (const PcdField& g : h->fields)
+      if (g.name == f.name && f.name != "_")
+        return BadFile(name, absl::StrCat("PCD header: repeated field ", Excerpt(f.name)));
+    f.size = static_cast<uint32_t>(size);
+    f.type = types[i][0];
+    f.count = static_cast<uint32_t>(count);
+    f.offset = h->point_step;
+    h->point_step += size * count;  // <= 64 KiB header / 2 fields * 8 * 4096: no overflow
+    h->values_per_point += count;
+    h->fields.push_back(f);
+  }
+  return absl::OkStatus();
+}
+
+absl::Status CheckXyz(const PcdHeader& h, std::string_view name) {
+  for (const char* axis : {"x", "y", "z"}) {
+    bool found = false;
+    for (const PcdField& f : h.fields) found |= f.name == axis;
+    if (!found) return BadFile(name, "PCD has no x, y and z fields");
+  }
+  for (const PcdField& f : h.fields)
+    if ((f.name == "x" || f.name == "y" || f.name == "z") && f.type != 'F')
+      return BadFile(name, absl::StrCat("field ", f.name, " must be float32 or float64"));
+  return absl::OkStatus();
+}
+
+absl::Status ParseDims(const Entries& e, const CloudReadLimits& limits, std::string_view name,
+                       PcdHeader* h) {
+  uint64_t width = 0, height = 0, points = 0;
+  auto one = [&](const char* key, uint64_t* v) {
+    const auto& t = e.at(key);
+    return t.size() == 1 && ParseUint(t[0], v);
+  };
+  if (!one("WIDTH", &width) || !one("HEIGHT", &height) || !one("POINTS", &points))
+    return BadFile(name, "PCD header: WIDTH, HEIGHT or POINTS is not a number");
+  if (width == 0 || height == 0 || points == 0) return BadFile(name, "PCD holds no points");
+  uint64_t product = 0;
+  if (width > std::numeric_limits<uint32_t>::max() ||
+      height > std::numeric_limits<uint32_t>::max() || !CheckedMul(width, height, &product) ||
+      product != points)
+    return BadFile(name, absl::StrCat("PCD header: WIDTH*HEIGHT (", width, "*", height,
+                                      ") does not equal POINTS (", points, ")"));
+  if (points > limits.max_points)
+    return absl::ResourceExhaustedError(absl::StrCat(ToAbsl(name), ": ", points,
+                                                     " points exceed the limit of ",
+                                                     limits.max_points));
+  h->width = static_cast<uint32_t>(width);
+  h->height = static_cast<uint32_t>(height);
+  h->points = points;
+  return absl::OkStatus();
+}
+
+absl::Status ParseData(const Entries& e, std::string_view name, PcdHeader* h) {
+  const auto& t = e.at("DATA");
+  const std::string_view d = t.size() == 1 ? t[0] : std::string_view();
+  if (d == "ascii") {
+    h->data = PcdData::kAscii;
+  } else if (d == "binary") {
+    h->data = PcdData::kBinary;
+  } else if (d == "binary_compressed") {
+    h->data = PcdData::kBinaryCompressed;
+  } else {
+    return BadFile(name, absl::StrCat("PCD header: unknown DATA encoding '", Excerpt(d), "'"));
+  }
+  return absl::OkStatus();
+}
+
+// ---- data section ------------------------------------------------------
+
+struct AxisLayout {
+  uint64_t offset[3];     // byte offset in a binary record
+  uint32_t size[3];       // 4 or 8
+  uint64_t token[3];      // value index on an ascii line
+  uint64_t soa_start[3];  // byte offset of the field's block in decoded compressed data
+};
+
+AxisLayout Layout(const PcdHeader& h) {
+  AxisLayout l{};
+  uint64_t token = 0, soa = 0;
+  for (const PcdField& f : h.fields) {
+    const int a = f.name == "x" ? 0 : f.name == "y" ? 1 : f.name == "z" ? 2 : -1;
+    if (a >= 0) {
+      l.offset[a] = f.offset;
+      l.size[a] = f.size;
+      l.token[a] = token;
+      l.soa_start[a] = soa;
+    }
+    token += f.count;
+    soa += uint64_t{f.size} * f.count * h.points;  // <= decoded size, checked by the caller
+  }
+  return l;
+}
+
+float ToFloat(const uint8_t* p, uint32_t size) {
+  if (size == 4) {
+    float f;
+    std::memcpy(&f, p, 4);
+    return f;
+  }
+  double d;
+  std::memcpy(&d, p, 8);
+  return static_cast<float>(d);
+}
+
+PointCloud EmptyGrid(const PcdHeader& h) {
+  PointCloud c;
+  c.width = h.width;
+  c.height = h.height;
+  c.points.resize(h.points);
+  return c;
+}
+
+absl::StatusOr<PointCloud> DecodeBinary(std::string_view data, const PcdHeader& h,
+                                        std::string_view name) {
+  uint64_t need = 0;
+  if (!CheckedMul(h.points, h.point_step, &need))
+    return BadFile(name, "PCD header: the declared data size overflows");
+  if (data.size() < need)
+    return BadFile(name, absl::StrCat("truncated: ", h.points, " points need ", need,
+                                      " data bytes, file has ", data.size()));
+  const AxisLayout l = Layout(h);
+  PointCloud c = EmptyGrid(h);
+  const auto* base = reinterpret_cast<const uint8_t*>(data.data());
+  for (uint64_t i = 0; i < h.points; ++i) {
+    const uint8_t* rec = base + i * h.point_step;
+    for (int a = 0; a < 3; ++a) c.points[i][a] = ToFloat(rec + l.offset[a], l.size[a]);
+  }
+  return c;
+}
+
+absl::StatusOr<PointCloud> DecodeCompressed(std::string_view data, const PcdHeader& h,
+                                            std::string_view name) {
+  uint32_t sizes[2];
+  if (data.size() < 8) return BadFile(name, "truncated: compressed block sizes missing");
+  std::memcpy(sizes, data.data(), 8);
+  uint64_t need = 0;
+  if (!CheckedMul(h.points, h.point_step, &need) || sizes[1] != need)
+    return BadFile(name, "compressed PCD: uncompressed size disagrees with the header");
+  if (sizes[0] == 0 || sizes[0] > data.size() - 8)
+    return BadFile(name, "truncated: compressed data shorter than declared");
+  auto decoded = LzfDecompress(data.substr(8, sizes[0]), sizes[1]);
+  if (!decoded.ok()) return BadFile(name, absl::StrCat("compressed PCD: ", decoded.status().message()));
+  // The decoded block is field-major: all x values, then all y values, ...
+  const AxisLayout l = Layout(h);
+  PointCloud c = EmptyGrid(h);
+  for (uint64_t i = 0; i < h.points; ++i)
+    for (int a = 0; a < 3; ++a)
+      c.points[i][a] = ToFloat(decoded->data() + l.soa_start[a] + i * l.size[a], l.size[a]);
+  return c;
+}
+
+// PCL's ascii values: "nan" (any case) is a quiet NaN, others decimal.
+bool AsciiValue(std::string_view tok, uint32_t size, float* out) {
+  if (tok.size() == 3 && (tok[0] | 0x20) == 'n' && (tok[1] | 0x20) == 'a' && (tok[2] | 0x20) == 'n') {
+    *out = std::numeric_limits<float>::quiet_NaN();
+    return true;
+  }
+  if (size == 4) return ParseFloat(tok, out);
+  double d;
+  if (!ParseDouble(tok, &d)) return false;
+  *out = static_cast<float>(d);
+  return true;
+}
+
+absl::StatusOr<PointCloud> DecodeAscii(std::string_view bytes, const PcdHeader& h,
+                                       std::string_view name) {
+  const AxisLayout l = Layout(h);
+  PointCloud c;
+  c.width = h.width;
+  c.height = h.height;
+  // An ascii number takes at least 2 bytes with its separator.
+  const uint64_t fit = (bytes.size() - h.data_offset) / 2 / h.values_per_point + 1;
+  c.points.reserve(std::min(h.points, fit));
+  LineScanner lines(bytes, h.data_offset);
+  std::string_view line;
+  std::vector<std::string_view> tok;
+  while (c.points.size() < h.points && lines.Next(&line)) {
+    if (IsBlank(line)) continue;
+    SplitWhitespace(line, &tok);
+    if (tok.size() != h.values_per_point)
+      return BadFile(name, absl::StrCat("data line ", c.points.size() + 1, " has ", tok.size(),
+                                        " values, the header declares ", h.values_per_point));
+    Eigen::Vector3f p;
+    for (int a = 0; a < 3; ++a)
+      if (!AsciiValue(tok[l.token[a]], l.size[a], &p[a]))
+        return BadFile(name, absl::StrCat("data line ", c.points.size() + 1, ": bad number '",
+                                          Excerpt(tok[l.token[a]]), "'"));
+    c.points.push_back(p);
+  }
+  if (c.points.size() < h.points)
+    return BadFile(name, absl::StrCat("truncated: ", h.points, " points declared, ",
+                                      c.points.size(), " data lines found"));
+  return c;
+}
+
+}  // namespace
+
+absl::StatusOr<PcdHeader> ParsePcdHeader(std::string_view bytes, const CloudReadLimits& limits,
+                                         std::string_view name) {
+  Entries e;
+  PcdHeader h;
+  if (auto st = ReadEntries(bytes, name, &e, &h.data_offset); !st.ok()) return st;
+  for (const char* key : {"FIELDS", "SIZE", "TYPE", "WIDTH", "HEIGHT", "POINTS", "DATA"})
+    if (!e.count(key)) return BadFile(name, absl::StrCat("PCD header lacks ", key));
+  if (auto st = CheckSimpleEntries(e, name); !st.ok()) return st;
+  if (auto st = BuildFields(e, name, &h); !st.ok()) return st;
+  if (auto st = CheckXyz(h, name); !st.ok()) return st;
+  if (auto st = ParseDims(e, limits, name, &h); !st.ok()) return st;
+  if (auto st = ParseData(e, name, &h); !st.ok()) return st;
+  return h;
+}
+
+absl::StatusOr<PointCloud> ParsePcd(std::string_view bytes, const CloudReadLimits& limits,
+                                    std::string_view name) {
+  auto h = ParsePcdHeader(bytes, limits, name);
+  if (!h.ok()) return h.status();
+  const std::string_view data = bytes.substr(h->data_offset);
+  absl::StatusOr<PointCloud> cloud =
+      h->data == PcdData::kBinary             ? DecodeBinary(data, *h, name)
+      : h->data == PcdData::kBinaryCompressed ? DecodeCompressed(data, *h, name)
+                                              : DecodeAscii(bytes, *h, name);
+  if (!cloud.ok()) return cloud;
+  if (auto st = cloud->Validate(); !st.ok()) return BadFile(name, st.message());
+  return cloud;
+}
+
+}  // namespace surfinspect
