@@ -19,6 +19,13 @@
 namespace surfinspect {
 namespace {
 
+absl::Status Bad(const std::string& path, absl::string_view why) { return BadFile(path, why); }
+
+std::string Extension(const std::string& path) {
+  const auto dot = path.rfind('.');
+  return dot == std::string::npos ? "" : absl::AsciiStrToLower(path.substr(dot + 1));
+}
+
 // ---- writing through PCL ---------------------------------------------
 
 pcl::PCLPointCloud2 ToBlob(const PointCloud& cloud, bool valid_only) {
