@@ -129,14 +129,21 @@ absl::StatusOr<TriangleMesh> TriangulateAndMerge(const IndexedPolygons& p, std::
 }
 
 namespace {
+// Thrown by fast_atoreal_move instead of Assimp's DeadlyImportError (whose
+// base is not exported by the shared library).
+struct AtofOverflow {
+  template <typename... T>
+  explicit AtofOverflow(T&&...) {}
+};
+
 template <typename Real>
 bool AssimpReal(std::string_view token, Real* out) {
   double check;
   if (!ParseDouble(token, &check) || token.size() > 64) return false;
   const std::string terminated(token);
   try {
-    Assimp::fast_atoreal_move<Real>(terminated.c_str(), *out, /*check_comma=*/false);
-  } catch (const std::exception&) {
+    Assimp::fast_atoreal_move<Real, AtofOverflow>(terminated.c_str(), *out, /*check_comma=*/false);
+  } catch (const AtofOverflow&) {
     return false;  // more digits than fit in 64 bits
   }
   return true;
