@@ -56,8 +56,9 @@ absl::Status CheckCounts(const OffCounts& c, uint64_t remaining, const MeshReadL
   if (c.faces > limits.max_triangles)
     return absl::ResourceExhaustedError(absl::StrCat(
         ToAbsl(name), ": ", c.faces, " faces exceed the limit of ", limits.max_triangles));
+  // A vertex line takes at least "0 0 0\n", a face line at least "0\n".
   uint64_t need = 0, face_bytes = 0;
-  if (!CheckedMul(c.vertices, 6, &need) || !CheckedMul(c.faces, 8, &face_bytes) ||
+  if (!CheckedMul(c.vertices, 6, &need) || !CheckedMul(c.faces, 2, &face_bytes) ||
       !CheckedAdd(need, face_bytes, &need) || need - 1 > remaining)
     return BadFile(name, absl::StrCat("cannot import: OFF header declares ", c.vertices,
                                       " vertices and ", c.faces,

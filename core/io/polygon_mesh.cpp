@@ -69,8 +69,9 @@ std::vector<Triangle> Triangulate(const IndexedPolygons& p) {
     Triangle a{f[k], f[(k + 1) % 4], f[(k + 2) % 4]};
     Triangle b{f[k], f[(k + 2) % 4], f[(k + 3) % 4]};
     if (a[0] == last_first) {
+      // Both now start at the diagonal's far corner.
       a = {a[2], a[0], a[1]};
-      b = {b[2], b[0], b[1]};
+      b = {b[1], b[2], b[0]};
     }
     last_first = a[0];
     tris.push_back(a);
