@@ -84,8 +84,12 @@ bool ParseInt(std::string_view s, int64_t* out) {
 }
 
 namespace {
-// absl's parsers skip surrounding whitespace; a token must not have any.
-bool PlainToken(std::string_view s) { return !s.empty() && !IsSpace(s.front()) && !IsSpace(s.back()); }
+// absl's parsers skip surrounding whitespace and read hexadecimal; a token
+// must be plain decimal.
+bool PlainToken(std::string_view s) {
+  return !s.empty() && !IsSpace(s.front()) && !IsSpace(s.back()) &&
+         s.find_first_of("xX") == std::string_view::npos;
+}
 }  // namespace
 
 bool ParseFloat(std::string_view s, float* out) {
