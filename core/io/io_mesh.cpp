@@ -6,6 +6,7 @@
 
 #include <assimp/Exporter.hpp>
 #include <assimp/Importer.hpp>
+
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "core/io/atomic_file.h"
@@ -81,9 +82,8 @@ absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path, const MeshReadLim
   auto mesh = ReadByFormat(path, Extension(path), limits);
   if (!mesh.ok()) return mesh.status();
   if (mesh->num_triangles() > limits.max_triangles)
-    return absl::ResourceExhaustedError(absl::StrCat(path, ": ", mesh->num_triangles(),
-                                                     " faces exceed the limit of ",
-                                                     limits.max_triangles));
+    return absl::ResourceExhaustedError(absl::StrCat(
+        path, ": ", mesh->num_triangles(), " faces exceed the limit of ", limits.max_triangles));
   if (auto st = mesh->Validate(); !st.ok()) return Bad(path, st.message());
   return mesh;
 }

@@ -13,8 +13,8 @@ namespace surfinspect {
 absl::StatusOr<std::vector<uint8_t>> LzfDecompress(std::string_view compressed,
                                                    uint64_t decoded_size) {
   if (decoded_size / kLzfMaxExpansion > compressed.size())
-    return absl::InvalidArgumentError(absl::StrCat("LZF block of ", compressed.size(),
-                                                   " bytes cannot decode to ", decoded_size));
+    return absl::InvalidArgumentError(
+        absl::StrCat("LZF block of ", compressed.size(), " bytes cannot decode to ", decoded_size));
   std::vector<uint8_t> out(decoded_size);
   const auto* in = reinterpret_cast<const uint8_t*>(compressed.data());
   const std::size_t in_size = compressed.size();
@@ -26,8 +26,8 @@ absl::StatusOr<std::vector<uint8_t>> LzfDecompress(std::string_view compressed,
       if (len > in_size - ip)
         return absl::InvalidArgumentError("LZF literal run passes the end of its block");
       if (len > decoded_size - op)
-        return absl::InvalidArgumentError(absl::StrCat(
-            "LZF block decodes past its declared size of ", decoded_size, " bytes"));
+        return absl::InvalidArgumentError(
+            absl::StrCat("LZF block decodes past its declared size of ", decoded_size, " bytes"));
       std::memcpy(out.data() + op, in + ip, len);
       ip += len;
       op += len;
@@ -50,8 +50,8 @@ absl::StatusOr<std::vector<uint8_t>> LzfDecompress(std::string_view compressed,
     for (std::size_t k = 0; k < len; ++k, ++op) out[op] = out[op - distance];
   }
   if (op != decoded_size)
-    return absl::InvalidArgumentError(absl::StrCat("LZF block decodes to ", op,
-                                                   " bytes, not its declared ", decoded_size));
+    return absl::InvalidArgumentError(
+        absl::StrCat("LZF block decodes to ", op, " bytes, not its declared ", decoded_size));
   return out;
 }
 

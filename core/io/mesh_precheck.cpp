@@ -15,9 +15,8 @@ absl::Status Refuse(std::string_view name, absl::string_view why) {
 }
 
 absl::Status TooMany(std::string_view name, uint64_t n, const MeshReadLimits& limits) {
-  return absl::ResourceExhaustedError(absl::StrCat(ToAbsl(name), ": ", n,
-                                                   " faces exceed the limit of ",
-                                                   limits.max_triangles));
+  return absl::ResourceExhaustedError(
+      absl::StrCat(ToAbsl(name), ": ", n, " faces exceed the limit of ", limits.max_triangles));
 }
 
 // Whitespace-separated words of an ASCII STL, with the line each is on.
@@ -84,7 +83,8 @@ absl::Status CheckAsciiStl(std::string_view bytes, const MeshReadLimits& limits,
   std::string_view word;
   uint64_t facets = 0, solids = 0;
   while (w.Next(&word)) {
-    if (word != "solid") return Refuse(name, absl::StrCat("ASCII STL line ", w.line(), ": expected 'solid'"));
+    if (word != "solid")
+      return Refuse(name, absl::StrCat("ASCII STL line ", w.line(), ": expected 'solid'"));
     w.SkipLine();  // the solid's name
     ++solids;
     while (true) {
@@ -94,8 +94,9 @@ absl::Status CheckAsciiStl(std::string_view bytes, const MeshReadLimits& limits,
         break;
       }
       if (word != "facet")
-        return Refuse(name, absl::StrCat("ASCII STL line ", w.line(), ": expected 'facet' or 'endsolid', found '",
-                                         Excerpt(word), "'"));
+        return Refuse(
+            name, absl::StrCat("ASCII STL line ", w.line(),
+                               ": expected 'facet' or 'endsolid', found '", Excerpt(word), "'"));
       if (auto st = Facet(&w, facets, name); !st.ok()) return st;
       if (++facets > limits.max_triangles) return TooMany(name, facets, limits);
     }
@@ -106,8 +107,7 @@ absl::Status CheckAsciiStl(std::string_view bytes, const MeshReadLimits& limits,
 
 }  // namespace
 
-absl::Status CheckStl(std::string_view bytes, const MeshReadLimits& limits,
-                      std::string_view name) {
+absl::Status CheckStl(std::string_view bytes, const MeshReadLimits& limits, std::string_view name) {
   if (bytes.size() >= 84) {
     uint32_t n = 0;
     std::memcpy(&n, bytes.data() + 80, 4);
@@ -117,7 +117,8 @@ absl::Status CheckStl(std::string_view bytes, const MeshReadLimits& limits,
     }
   }
   std::size_t start = 0;
-  while (start < bytes.size() && std::strchr(" \t\r\n", bytes[start]) && bytes[start] != '\0') ++start;
+  while (start < bytes.size() && std::strchr(" \t\r\n", bytes[start]) && bytes[start] != '\0')
+    ++start;
   if (bytes.substr(start, 5) == "solid") return CheckAsciiStl(bytes.substr(start), limits, name);
   if (bytes.size() < 84) return Refuse(name, "too short for a binary STL and not an ASCII one");
   uint32_t n = 0;
@@ -177,7 +178,8 @@ absl::Status CheckObjLine(const std::vector<std::string_view>& tok, const ObjCou
   double d;
   if (key == "v" || key == "vt" || key == "vn") {
     const std::size_t lo = key == "vt" ? 1 : 3, hi = key == "v" ? 7 : 3;
-    if (tok.size() - 1 < lo || tok.size() - 1 > hi) return bad(absl::StrCat("'", ToAbsl(key), "' needs ", lo, " to ", hi, " numbers"));
+    if (tok.size() - 1 < lo || tok.size() - 1 > hi)
+      return bad(absl::StrCat("'", ToAbsl(key), "' needs ", lo, " to ", hi, " numbers"));
     for (std::size_t k = 1; k < tok.size(); ++k)
       if (!ParseDouble(tok[k], &d)) return bad(absl::StrCat("bad number '", Excerpt(tok[k]), "'"));
     ++(key == "v" ? so_far->v : key == "vt" ? so_far->vt : so_far->vn);
@@ -186,8 +188,10 @@ absl::Status CheckObjLine(const std::vector<std::string_view>& tok, const ObjCou
   if (key != "f" && key != "l" && key != "p") return absl::OkStatus();
   const uint64_t corners = tok.size() - 1;
   if (corners == 0) return bad(absl::StrCat("'", ToAbsl(key), "' without indices"));
-  if (key == "f" && corners < 3) return bad(absl::StrCat("a face has ", corners, " indices (a face needs at least 3)"));
-  if (corners > kMaxObjCorners) return bad(absl::StrCat("a face has ", corners, " corners, over ", kMaxObjCorners));
+  if (key == "f" && corners < 3)
+    return bad(absl::StrCat("a face has ", corners, " indices (a face needs at least 3)"));
+  if (corners > kMaxObjCorners)
+    return bad(absl::StrCat("a face has ", corners, " corners, over ", kMaxObjCorners));
   for (std::size_t k = 1; k < tok.size(); ++k)
     if (!CornerOk(tok[k], total, *so_far))
       return bad(absl::StrCat("vertex index '", Excerpt(tok[k]), "' out of range (", total.v,
@@ -198,8 +202,7 @@ absl::Status CheckObjLine(const std::vector<std::string_view>& tok, const ObjCou
 
 }  // namespace
 
-absl::Status CheckObj(std::string_view bytes, const MeshReadLimits& limits,
-                      std::string_view name) {
+absl::Status CheckObj(std::string_view bytes, const MeshReadLimits& limits, std::string_view name) {
   const ObjCounts total = CountObjEntries(bytes);
   ObjCounts so_far;
   uint64_t faces = 0;

@@ -36,15 +36,16 @@ absl::StatusOr<OffCounts> ParseCounts(LineScanner* lines, std::string_view name)
   if (!NextTokens(lines, &tok) || !KnownKeyword(tok[0]))
     return BadFile(name, "cannot import: not an OFF file (no OFF keyword on the first line)");
   std::vector<std::string_view> counts(tok.begin() + 1, tok.end());
-  if (!counts.empty() && counts[0] == "BINARY") return BadFile(name, "cannot import: binary OFF is not read");
+  if (!counts.empty() && counts[0] == "BINARY")
+    return BadFile(name, "cannot import: binary OFF is not read");
   if (counts.empty()) {
     if (!NextTokens(lines, &tok)) return BadFile(name, "cannot import: OFF header has no counts");
     counts = tok;
   }
   OffCounts c;
   uint64_t edges = 0;
-  if (counts.size() != 3 || !ParseUint(counts[0], &c.vertices) ||
-      !ParseUint(counts[1], &c.faces) || !ParseUint(counts[2], &edges))
+  if (counts.size() != 3 || !ParseUint(counts[0], &c.vertices) || !ParseUint(counts[1], &c.faces) ||
+      !ParseUint(counts[2], &edges))
     return BadFile(name, "cannot import: OFF counts must be three integers (vertices faces edges)");
   return c;
 }
@@ -61,9 +62,8 @@ absl::Status CheckCounts(const OffCounts& c, uint64_t remaining, const MeshReadL
   if (!CheckedMul(c.vertices, 6, &need) || !CheckedMul(c.faces, 2, &face_bytes) ||
       !CheckedAdd(need, face_bytes, &need) || need - 1 > remaining)
     return BadFile(name, absl::StrCat("cannot import: OFF header declares ", c.vertices,
-                                      " vertices and ", c.faces,
-                                      " faces, more than the file's ", remaining,
-                                      " remaining bytes can hold"));
+                                      " vertices and ", c.faces, " faces, more than the file's ",
+                                      remaining, " remaining bytes can hold"));
   return absl::OkStatus();
 }
 
@@ -73,8 +73,8 @@ absl::Status ReadVertices(LineScanner* lines, uint64_t n, std::string_view name,
   out->reserve(n);
   for (uint64_t i = 0; i < n; ++i) {
     if (!NextTokens(lines, &tok))
-      return BadFile(name, absl::StrCat("cannot import: truncated: ", n, " vertices declared, ", i,
-                                        " found"));
+      return BadFile(
+          name, absl::StrCat("cannot import: truncated: ", n, " vertices declared, ", i, " found"));
     Eigen::Vector3f p;
     bool ok = tok.size() >= 3;
     for (int a = 0; ok && a < 3; ++a) ok = ParseMeshCoordinate(tok[a], &p[a]);
@@ -92,8 +92,8 @@ absl::Status ReadFaces(LineScanner* lines, uint64_t n, uint64_t vertices, std::s
   out->sizes.reserve(n);
   for (uint64_t f = 0; f < n; ++f) {
     if (!NextTokens(lines, &tok))
-      return BadFile(name, absl::StrCat("cannot import: truncated: ", n, " faces declared, ", f,
-                                        " found"));
+      return BadFile(
+          name, absl::StrCat("cannot import: truncated: ", n, " faces declared, ", f, " found"));
     uint64_t corners = 0;
     if (!ParseUint(tok[0], &corners))
       return BadFile(name, absl::StrCat("cannot import: face ", f, ": bad corner count"));
@@ -104,14 +104,14 @@ absl::Status ReadFaces(LineScanner* lines, uint64_t n, uint64_t vertices, std::s
       return BadFile(name, absl::StrCat("cannot import: face ", f, " has ", corners,
                                         " corners; only triangles and quads are read"));
     if (tok.size() < corners + 1)
-      return BadFile(name, absl::StrCat("cannot import: face ", f, " lists fewer indices than ",
-                                        corners));
+      return BadFile(
+          name, absl::StrCat("cannot import: face ", f, " lists fewer indices than ", corners));
     for (uint64_t k = 1; k <= corners; ++k) {
       uint64_t idx = 0;
       if (!ParseUint(tok[k], &idx) || idx >= vertices)
-        return BadFile(name, absl::StrCat("cannot import: face ", f, ": vertex index '",
-                                          Excerpt(tok[k]), "' out of range (", vertices,
-                                          " vertices)"));
+        return BadFile(name,
+                       absl::StrCat("cannot import: face ", f, ": vertex index '", Excerpt(tok[k]),
+                                    "' out of range (", vertices, " vertices)"));
       out->corners.push_back(static_cast<uint32_t>(idx));
     }
     double extra;

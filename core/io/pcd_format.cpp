@@ -40,8 +40,8 @@ absl::Status ReadEntries(std::string_view bytes, std::string_view name, Entries*
       return BadFile(name, absl::StrCat("PCD header line ", lines.line_number(), ": unknown key '",
                                         Excerpt(tok[0]), "'"));
     if (entries->count(key))
-      return BadFile(name, absl::StrCat("PCD header line ", lines.line_number(), ": repeated key ",
-                                        key));
+      return BadFile(name,
+                     absl::StrCat("PCD header line ", lines.line_number(), ": repeated key ", key));
     (*entries)[key].assign(tok.begin() + 1, tok.end());
     if (key == "DATA") {
       *data_offset = lines.pos();
@@ -130,9 +130,8 @@ absl::Status ParseDims(const Entries& e, const CloudReadLimits& limits, std::str
     return BadFile(name, absl::StrCat("PCD header: WIDTH*HEIGHT (", width, "*", height,
                                       ") does not equal POINTS (", points, ")"));
   if (points > limits.max_points)
-    return absl::ResourceExhaustedError(absl::StrCat(ToAbsl(name), ": ", points,
-                                                     " points exceed the limit of ",
-                                                     limits.max_points));
+    return absl::ResourceExhaustedError(absl::StrCat(
+        ToAbsl(name), ": ", points, " points exceed the limit of ", limits.max_points));
   h->width = static_cast<uint32_t>(width);
   h->height = static_cast<uint32_t>(height);
   h->points = points;
@@ -228,7 +227,8 @@ absl::StatusOr<PointCloud> DecodeCompressed(std::string_view data, const PcdHead
   if (sizes[0] == 0 || sizes[0] > data.size() - 8)
     return BadFile(name, "truncated: compressed data shorter than declared");
   auto decoded = LzfDecompress(data.substr(8, sizes[0]), sizes[1]);
-  if (!decoded.ok()) return BadFile(name, absl::StrCat("compressed PCD: ", decoded.status().message()));
+  if (!decoded.ok())
+    return BadFile(name, absl::StrCat("compressed PCD: ", decoded.status().message()));
   // The decoded block is field-major: all x values, then all y values, ...
   const AxisLayout l = Layout(h);
   PointCloud c = EmptyGrid(h);
@@ -240,7 +240,8 @@ absl::StatusOr<PointCloud> DecodeCompressed(std::string_view data, const PcdHead
 
 // PCL's ascii values: "nan" (any case) is a quiet NaN, others decimal.
 bool AsciiValue(std::string_view tok, uint32_t size, float* out) {
-  if (tok.size() == 3 && (tok[0] | 0x20) == 'n' && (tok[1] | 0x20) == 'a' && (tok[2] | 0x20) == 'n') {
+  if (tok.size() == 3 && (tok[0] | 0x20) == 'n' && (tok[1] | 0x20) == 'a' &&
+      (tok[2] | 0x20) == 'n') {
     *out = std::numeric_limits<float>::quiet_NaN();
     return true;
   }
@@ -304,10 +305,10 @@ absl::StatusOr<PointCloud> ParsePcd(std::string_view bytes, const CloudReadLimit
   auto h = ParsePcdHeader(bytes, limits, name);
   if (!h.ok()) return h.status();
   const std::string_view data = bytes.substr(h->data_offset);
-  absl::StatusOr<PointCloud> cloud =
-      h->data == PcdData::kBinary             ? DecodeBinary(data, *h, name)
-      : h->data == PcdData::kBinaryCompressed ? DecodeCompressed(data, *h, name)
-                                              : DecodeAscii(bytes, *h, name);
+  absl::StatusOr<PointCloud> cloud = h->data == PcdData::kBinary ? DecodeBinary(data, *h, name)
+                                     : h->data == PcdData::kBinaryCompressed
+                                         ? DecodeCompressed(data, *h, name)
+                                         : DecodeAscii(bytes, *h, name);
   if (!cloud.ok()) return cloud;
   if (auto st = cloud->Validate(); !st.ok()) return BadFile(name, st.message());
   return cloud;

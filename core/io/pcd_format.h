@@ -25,10 +25,10 @@ enum class PcdData { kAscii, kBinary, kBinaryCompressed };
 
 struct PcdField {
   std::string name;
-  uint32_t size = 0;   // bytes per element: 1, 2, 4 or 8
-  char type = 'F';     // 'F' float, 'I' signed, 'U' unsigned
-  uint32_t count = 1;  // elements per point
-  uint64_t offset = 0; // byte offset inside a binary point record
+  uint32_t size = 0;    // bytes per element: 1, 2, 4 or 8
+  char type = 'F';      // 'F' float, 'I' signed, 'U' unsigned
+  uint32_t count = 1;   // elements per point
+  uint64_t offset = 0;  // byte offset inside a binary point record
 };
 
 struct PcdHeader {

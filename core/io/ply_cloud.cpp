@@ -11,9 +11,9 @@ namespace surfinspect {
 namespace {
 
 struct VertexLayout {
-  int prop[3];          // property index of x, y, z
-  PlyType type[3];      // float32 or float64
-  uint64_t offset[3];   // byte offset in a fixed-size binary row
+  int prop[3];         // property index of x, y, z
+  PlyType type[3];     // float32 or float64
+  uint64_t offset[3];  // byte offset in a fixed-size binary row
 };
 
 absl::StatusOr<VertexLayout> FindXyz(const PlyElement& v, std::string_view name) {
@@ -151,14 +151,15 @@ absl::StatusOr<PointCloud> ParsePlyCloud(std::string_view bytes, const CloudRead
   std::vector<Eigen::Vector3f> pts;
   std::vector<int64_t> cells;
   for (const PlyElement& e : h->elements) {
-    absl::Status st = &e == &vertex            ? ReadVertices(&reader, *h, e, *layout, name, &pts)
-                      : e.name == "range_grid" ? ReadRangeGrid(&reader, *h, e, vertex.count, name, &cells)
-                                               : reader.Skip(e);
+    absl::Status st = &e == &vertex ? ReadVertices(&reader, *h, e, *layout, name, &pts)
+                      : e.name == "range_grid"
+                          ? ReadRangeGrid(&reader, *h, e, vertex.count, name, &cells)
+                          : reader.Skip(e);
     if (!st.ok()) return st;
   }
   if (!cells.empty() && cells.size() != pts.size()) {
-    std::vector<Eigen::Vector3f> grid(cells.size(),
-                                      Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN()));
+    std::vector<Eigen::Vector3f> grid(
+        cells.size(), Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN()));
     for (std::size_t r = 0; r < cells.size(); ++r)
       if (cells[r] >= 0) grid[r] = pts[cells[r]];
     pts.swap(grid);

@@ -14,8 +14,7 @@
 
 namespace surfinspect {
 
-absl::StatusOr<PointCloud> ParsePlyCloud(std::string_view bytes,
-                                         const CloudReadLimits& limits = {},
+absl::StatusOr<PointCloud> ParsePlyCloud(std::string_view bytes, const CloudReadLimits& limits = {},
                                          std::string_view name = "<ply>");
 
 }  // namespace surfinspect

@@ -14,14 +14,13 @@ bool ParseType(std::string_view s, PlyType* t) {
   static constexpr struct {
     const char* name;
     PlyType type;
-  } kTypes[] = {{"char", PlyType::kInt8},      {"int8", PlyType::kInt8},
-                {"uchar", PlyType::kUint8},    {"uint8", PlyType::kUint8},
-                {"short", PlyType::kInt16},    {"int16", PlyType::kInt16},
-                {"ushort", PlyType::kUint16},  {"uint16", PlyType::kUint16},
-                {"int", PlyType::kInt32},      {"int32", PlyType::kInt32},
-                {"uint", PlyType::kUint32},    {"uint32", PlyType::kUint32},
-                {"float", PlyType::kFloat32},  {"float32", PlyType::kFloat32},
-                {"double", PlyType::kFloat64}, {"float64", PlyType::kFloat64}};
+  } kTypes[] = {
+      {"char", PlyType::kInt8},      {"int8", PlyType::kInt8},       {"uchar", PlyType::kUint8},
+      {"uint8", PlyType::kUint8},    {"short", PlyType::kInt16},     {"int16", PlyType::kInt16},
+      {"ushort", PlyType::kUint16},  {"uint16", PlyType::kUint16},   {"int", PlyType::kInt32},
+      {"int32", PlyType::kInt32},    {"uint", PlyType::kUint32},     {"uint32", PlyType::kUint32},
+      {"float", PlyType::kFloat32},  {"float32", PlyType::kFloat32}, {"double", PlyType::kFloat64},
+      {"float64", PlyType::kFloat64}};
   for (const auto& k : kTypes)
     if (s == k.name) {
       *t = k.type;
@@ -60,7 +59,8 @@ absl::Status ParseObjInfo(const std::vector<std::string_view>& tok, std::string_
   std::optional<uint64_t>& slot = tok[1] == "num_cols" ? h->num_cols : h->num_rows;
   uint64_t v = 0;
   if (tok.size() != 3 || !ParseUint(tok[2], &v))
-    return BadFile(name, absl::StrCat("PLY header: bad obj_info ", tok[1] == "num_cols" ? "num_cols" : "num_rows"));
+    return BadFile(name, absl::StrCat("PLY header: bad obj_info ",
+                                      tok[1] == "num_cols" ? "num_cols" : "num_rows"));
   if (slot) return BadFile(name, "PLY header: repeated obj_info grid size");
   slot = v;
   return absl::OkStatus();
@@ -282,7 +282,8 @@ absl::Status PlyRowReader::NextBinary(const PlyElement& element, uint64_t row_in
       if (!TakeBytes(PlyTypeSize(p.count_type), &c).ok())
         return RowError(element, row_index, "truncated data section");
       const int64_t len = static_cast<int64_t>(PlyBinaryDouble(header_.format, p.count_type, c));
-      if (len < 0) return RowError(element, row_index, absl::StrCat("negative list length for ", p.name));
+      if (len < 0)
+        return RowError(element, row_index, absl::StrCat("negative list length for ", p.name));
       n = static_cast<uint64_t>(len);
     }
     const uint64_t size = PlyTypeSize(p.type);
@@ -309,8 +310,8 @@ absl::Status PlyRowReader::Skip(const PlyElement& element) {
     uint64_t total = 0;
     const uint8_t* p = nullptr;
     if (!CheckedMul(*fixed, element.count, &total) || !TakeBytes(total, &p).ok())
-      return BadFile(name_, absl::StrCat("truncated: element ", Excerpt(element.name),
-                                         " needs ", element.count, " rows of ", *fixed, " bytes"));
+      return BadFile(name_, absl::StrCat("truncated: element ", Excerpt(element.name), " needs ",
+                                         element.count, " rows of ", *fixed, " bytes"));
     return absl::OkStatus();
   }
   PlyRow row;

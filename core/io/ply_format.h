@@ -22,7 +22,16 @@
 namespace surfinspect {
 
 enum class PlyFormat { kAscii, kBinaryLittleEndian, kBinaryBigEndian };
-enum class PlyType : uint8_t { kInt8, kUint8, kInt16, kUint16, kInt32, kUint32, kFloat32, kFloat64 };
+enum class PlyType : uint8_t {
+  kInt8,
+  kUint8,
+  kInt16,
+  kUint16,
+  kInt32,
+  kUint32,
+  kFloat32,
+  kFloat64
+};
 
 int PlyTypeSize(PlyType t);
 bool PlyTypeIsInteger(PlyType t);
@@ -46,8 +55,8 @@ struct PlyElement {
 struct PlyHeader {
   PlyFormat format = PlyFormat::kAscii;
   std::vector<PlyElement> elements;
-  std::optional<uint64_t> num_cols, num_rows;  // obj_info num_cols / num_rows
-  std::size_t data_offset = 0;                 // first byte after "end_header\n"
+  std::optional<uint64_t> num_cols, num_rows;       // obj_info num_cols / num_rows
+  std::size_t data_offset = 0;                      // first byte after "end_header\n"
   int FindElement(std::string_view element) const;  // -1 when absent
 };
 

@@ -38,8 +38,8 @@ absl::Status ReadVertices(PlyRowReader* reader, const PlyHeader& h, const PlyEle
     const char* axis[] = {"x", "y", "z"};
     prop[a] = e.FindProperty(axis[a]);
     if (prop[a] < 0 || e.properties[prop[a]].is_list)
-      return BadFile(name, absl::StrCat("cannot import: PLY vertex element has no '", axis[a],
-                                        "' property"));
+      return BadFile(
+          name, absl::StrCat("cannot import: PLY vertex element has no '", axis[a], "' property"));
   }
   out->reserve(std::min<uint64_t>(e.count, reader->RemainingBytes() / 2 + 1));
   PlyRow row;
@@ -96,7 +96,8 @@ absl::StatusOr<TriangleMesh> ParsePlyMesh(std::string_view bytes, const MeshRead
   if (!h.ok()) return h.status();
   const int vi = h->FindElement("vertex");
   const int fi = h->FindElement("face");
-  if (vi < 0 || h->elements[vi].count == 0) return BadFile(name, "cannot import: PLY has no vertices");
+  if (vi < 0 || h->elements[vi].count == 0)
+    return BadFile(name, "cannot import: PLY has no vertices");
   if (fi < 0 || h->elements[fi].count == 0) return BadFile(name, "cannot import: PLY has no faces");
   if (h->FindElement("tristrips") >= 0)
     return BadFile(name, "cannot import: PLY triangle strips (tristrips) are not read");
@@ -109,7 +110,8 @@ absl::StatusOr<TriangleMesh> ParsePlyMesh(std::string_view bytes, const MeshRead
   IndexedPolygons polygons;
   for (std::size_t i = 0; i < h->elements.size(); ++i) {
     const PlyElement& e = h->elements[i];
-    absl::Status st = static_cast<int>(i) == vi ? ReadVertices(&reader, *h, e, name, &polygons.vertices)
+    absl::Status st = static_cast<int>(i) == vi
+                          ? ReadVertices(&reader, *h, e, name, &polygons.vertices)
                       : static_cast<int>(i) == fi
                           ? ReadFaces(&reader, *h, e, h->elements[vi].count, name, &polygons)
                           : reader.Skip(e);

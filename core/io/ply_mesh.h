@@ -14,8 +14,7 @@
 
 namespace surfinspect {
 
-absl::StatusOr<TriangleMesh> ParsePlyMesh(std::string_view bytes,
-                                          const MeshReadLimits& limits = {},
+absl::StatusOr<TriangleMesh> ParsePlyMesh(std::string_view bytes, const MeshReadLimits& limits = {},
                                           std::string_view name = "<ply>");
 
 }  // namespace surfinspect

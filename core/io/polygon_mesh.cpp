@@ -104,7 +104,8 @@ absl::StatusOr<TriangleMesh> TriangulateAndMerge(const IndexedPolygons& p, std::
   }
   if (total != p.corners.size()) return BadFile(name, "cannot import: face corner count mismatch");
   for (uint32_t i : p.corners)
-    if (i >= nv) return BadFile(name, absl::StrCat("cannot import: vertex index ", i, " out of range"));
+    if (i >= nv)
+      return BadFile(name, absl::StrCat("cannot import: vertex index ", i, " out of range"));
   std::vector<Triangle> tris = Triangulate(p);
   std::vector<bool> used(nv, false);
   for (const Triangle& t : tris)

@@ -46,8 +46,9 @@ TEST(ParseOff, RefusesBadBodies) {
 }
 
 TEST(ParseOff, ReadsCommentsColoursQuadsAndCountsOnTheKeywordLine) {
-  auto m = ParseOff("# made by hand\nCOFF 5 2 0\n0 0 0 1 0 0 1\n1 0 0 1 0 0 1\n1 1 0 1 0 0 1 # c\n"
-                    "0 1 0 1 0 0 1\n0.2 0.2 0 1 0 0 1\n\n4 0 1 2 3\n4 0 1 4 3 0.5 0.5 0.5\n");
+  auto m = ParseOff(
+      "# made by hand\nCOFF 5 2 0\n0 0 0 1 0 0 1\n1 0 0 1 0 0 1\n1 1 0 1 0 0 1 # c\n"
+      "0 1 0 1 0 0 1\n0.2 0.2 0 1 0 0 1\n\n4 0 1 2 3\n4 0 1 4 3 0.5 0.5 0.5\n");
   ASSERT_TRUE(m.ok()) << m.status();
   EXPECT_EQ(m->vertices.size(), 5u);
   // The convex quad fans from corner 0; the concave one (corner 4 = (0.2, 0.2)) from there.

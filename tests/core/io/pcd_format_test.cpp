@@ -24,22 +24,26 @@ void ExpectRefused(const std::string& bytes, const char* message_part,
 
 TEST(ParsePcd, RefusesEveryMalformedHeaderWithItsReason) {
   const std::string dims = "WIDTH 1\nHEIGHT 1\nPOINTS 1\n";
-  ExpectRefused("surfinspect\n" + kHead + dims + "DATA ascii\n1 2 3\n", "unknown key 'surfinspect'");
+  ExpectRefused("surfinspect\n" + kHead + dims + "DATA ascii\n1 2 3\n",
+                "unknown key 'surfinspect'");
   ExpectRefused(kHead + "WIDTH 1\n" + dims + "DATA ascii\n1 2 3\n", "repeated key WIDTH");
-  ExpectRefused("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 \x07~ 1\n" + dims + kHead +
-                    dims + "DATA ascii\n1 2 3\n",
+  ExpectRefused("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 \x07~ 1\n" + dims +
+                    kHead + dims + "DATA ascii\n1 2 3\n",
                 "line 9: repeated key VERSION");
   ExpectRefused("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 \x07~ 1\n" + dims +
                     "DATA ascii\n1 2 3\n",
                 "bad COUNT for field y");
   ExpectRefused("VERSION 0.7\nFIELDS x y z\nSIZE 4 4\nTYPE F F F\n" + dims + "DATA ascii\n1 2 3\n",
                 "FIELDS, SIZE, TYPE and COUNT disagree in length");
-  ExpectRefused("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 2\nTYPE F F F\n" + dims + "DATA ascii\n1 2 3\n",
-                "bad TYPE for field z");
-  ExpectRefused("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F U\n" + dims + "DATA ascii\n1 2 3\n",
-                "field z must be float32 or float64");
-  ExpectRefused("VERSION 0.7\nFIELDS x y x z\nSIZE 4 4 4 4\nTYPE F F F F\n" + dims + "DATA ascii\n1 2 3 4\n",
-                "repeated field x");
+  ExpectRefused(
+      "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 2\nTYPE F F F\n" + dims + "DATA ascii\n1 2 3\n",
+      "bad TYPE for field z");
+  ExpectRefused(
+      "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F U\n" + dims + "DATA ascii\n1 2 3\n",
+      "field z must be float32 or float64");
+  ExpectRefused(
+      "VERSION 0.7\nFIELDS x y x z\nSIZE 4 4 4 4\nTYPE F F F F\n" + dims + "DATA ascii\n1 2 3 4\n",
+      "repeated field x");
   ExpectRefused(kHead + "WIDTH 1x\nHEIGHT 1\nPOINTS 1\nDATA ascii\n1 2 3\n", "not a number");
   ExpectRefused(kHead + "WIDTH 4294967296\nHEIGHT 4294967296\nPOINTS 0\nDATA binary\n",
                 "no points");
@@ -70,7 +74,10 @@ TEST(ParsePcd, RefusesShortOrBadDataSections) {
   ExpectRefused(comp + std::string("\x40\0\0\0\x0c\0\0\0", 8) + "abc",
                 "compressed data shorter than declared");
   // A 4-byte literal, then a 264-byte back reference: past the 12 declared bytes.
-  ExpectRefused(comp + std::string("\x08\0\0\0\x0c\0\0\0", 8) + std::string("\x03" "abcd\xe0\xff\x03", 8),
+  ExpectRefused(comp + std::string("\x08\0\0\0\x0c\0\0\0", 8) +
+                    std::string("\x03"
+                                "abcd\xe0\xff\x03",
+                                8),
                 "LZF block decodes past its declared size");
 }
 
@@ -82,7 +89,8 @@ TEST(ParsePcd, ReadsWhatPclWritesInEveryEncodingBitExact) {
   std::uniform_real_distribution<float> u(-500.f, 500.f);
   for (std::size_t i = 0; i < grid.size(); ++i)
     if (i % 4 != 1) grid.points[i] = {u(rng), u(rng), u(rng)};
-  for (PcdEncoding enc : {PcdEncoding::kAscii, PcdEncoding::kBinary, PcdEncoding::kBinaryCompressed}) {
+  for (PcdEncoding enc :
+       {PcdEncoding::kAscii, PcdEncoding::kBinary, PcdEncoding::kBinaryCompressed}) {
     const std::string path = dir.File("g.pcd");
     ASSERT_TRUE(WritePointCloud(path, grid, enc).ok());
     auto back = ParsePcd(testing::ReadBytes(path));

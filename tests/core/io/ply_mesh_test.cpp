@@ -31,23 +31,28 @@ TEST(ParsePlyMesh, RefusesBadFacesWithTheirNumber) {
   ExpectRefused(kHead + "3 0 1 2 7\n", "1 values more");
   ExpectRefused(kHead.substr(0, kHead.find("end_header")), "no 'end_header'");
   ExpectRefused(kHead.substr(0, kHead.find("end_header")) + "0 0 0\n", "unknown line '0 0 0'");
-  ExpectRefused(kHead.substr(0, kHead.rfind("0 1 0\n")), "truncated: element vertex declares 3 rows, 2 found");
+  ExpectRefused(kHead.substr(0, kHead.rfind("0 1 0\n")),
+                "truncated: element vertex declares 3 rows, 2 found");
 }
 
 TEST(ParsePlyMesh, RefusesFilesWithoutASurface) {
-  ExpectRefused("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
-                "property float z\nend_header\n0 0 0\n",
-                "no faces");
-  ExpectRefused("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
-                "element face 0\nproperty list uchar int vertex_indices\nend_header\n0 0\n",
-                "no faces");
-  ExpectRefused("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
-                "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0\n3 0 0 0\n",
-                "no 'z' property");
-  ExpectRefused("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
-                "property float z\nelement face 1\nproperty list uchar float vertex_indices\n"
-                "end_header\n0 0 0\n3 0 0 0\n",
-                "integer vertex_indices");
+  ExpectRefused(
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+      "property float z\nend_header\n0 0 0\n",
+      "no faces");
+  ExpectRefused(
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+      "element face 0\nproperty list uchar int vertex_indices\nend_header\n0 0\n",
+      "no faces");
+  ExpectRefused(
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0\n3 0 0 0\n",
+      "no 'z' property");
+  ExpectRefused(
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar float vertex_indices\n"
+      "end_header\n0 0 0\n3 0 0 0\n",
+      "integer vertex_indices");
 }
 
 TEST(ParsePlyMesh, FaceCountOverTheLimitIsResourceExhausted) {

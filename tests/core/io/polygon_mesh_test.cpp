@@ -35,11 +35,11 @@ TEST(TriangulateAndMerge, DropsUnreferencedMergesEqualAndKeepsFileOrder) {
 }
 
 TEST(TriangulateAndMerge, MergesOnlyEqualCoordinatesWithMinusZeroEqualToZero) {
-  auto m = ParsePlyMesh(Ply("5 5 5\n1 0 0\n1.000001 0 0\n0 1 0\n0 0 0\n5 5 5\n1.00001 0 0\n-0 1 0\n",
-                            8, "3 5 1 3\n3 2 6 4\n3 7 1 4\n", 3));
+  auto m =
+      ParsePlyMesh(Ply("5 5 5\n1 0 0\n1.000001 0 0\n0 1 0\n0 0 0\n5 5 5\n1.00001 0 0\n-0 1 0\n", 8,
+                       "3 5 1 3\n3 2 6 4\n3 7 1 4\n", 3));
   ASSERT_TRUE(m.ok()) << m.status();
-  ExpectMesh(*m,
-             {{1, 0, 0}, {1.000001f, 0, 0}, {0, 1, 0}, {0, 0, 0}, {5, 5, 5}, {1.00001f, 0, 0}},
+  ExpectMesh(*m, {{1, 0, 0}, {1.000001f, 0, 0}, {0, 1, 0}, {0, 0, 0}, {5, 5, 5}, {1.00001f, 0, 0}},
              {{4, 0, 2}, {1, 5, 3}, {2, 0, 3}});
 }
 

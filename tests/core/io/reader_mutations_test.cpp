@@ -73,27 +73,33 @@ int Mutate(const char* target, const Parser& parse, int rounds) {
 constexpr int kRounds = 3000;
 
 TEST(ReaderMutations, Pcd) {
-  Mutate("pcd", [](std::string_view b) { return ParsePcd(b).status(); }, kRounds);
+  Mutate(
+      "pcd", [](std::string_view b) { return ParsePcd(b).status(); }, kRounds);
 }
 
 TEST(ReaderMutations, PlyCloud) {
-  Mutate("ply_cloud", [](std::string_view b) { return ParsePlyCloud(b).status(); }, kRounds);
+  Mutate(
+      "ply_cloud", [](std::string_view b) { return ParsePlyCloud(b).status(); }, kRounds);
 }
 
 TEST(ReaderMutations, PlyMesh) {
-  Mutate("ply_mesh", [](std::string_view b) { return ParsePlyMesh(b).status(); }, kRounds);
+  Mutate(
+      "ply_mesh", [](std::string_view b) { return ParsePlyMesh(b).status(); }, kRounds);
 }
 
 TEST(ReaderMutations, Off) {
-  Mutate("off", [](std::string_view b) { return ParseOff(b).status(); }, kRounds);
+  Mutate(
+      "off", [](std::string_view b) { return ParseOff(b).status(); }, kRounds);
 }
 
 TEST(ReaderMutations, StlCheck) {
-  Mutate("stl", [](std::string_view b) { return CheckStl(b); }, kRounds);
+  Mutate(
+      "stl", [](std::string_view b) { return CheckStl(b); }, kRounds);
 }
 
 TEST(ReaderMutations, ObjCheck) {
-  Mutate("obj", [](std::string_view b) { return CheckObj(b); }, kRounds);
+  Mutate(
+      "obj", [](std::string_view b) { return CheckObj(b); }, kRounds);
 }
 
 }  // namespace

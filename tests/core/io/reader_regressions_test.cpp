@@ -52,7 +52,8 @@ TEST(ReaderRegressions, EveryCorpusFileGivesItsExpectedStatusWithinASecond) {
         ++seeds;
         EXPECT_TRUE(st.ok()) << t.name << "/" << file << ": " << st;
       } else {
-        ASSERT_EQ(file.rfind("regress-", 0), 0u) << "corpus files are seed-* or regress-*: " << file;
+        ASSERT_EQ(file.rfind("regress-", 0), 0u)
+            << "corpus files are seed-* or regress-*: " << file;
         ++regressions;
         EXPECT_FALSE(st.ok()) << t.name << "/" << file;
         EXPECT_FALSE(st.message().empty()) << t.name << "/" << file;
