@@ -6,12 +6,14 @@
 
 #include <assimp/Exporter.hpp>
 #include <assimp/Importer.hpp>
+#include <fstream>
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "core/io/atomic_file.h"
 #include "core/io/mesh_precheck.h"
 #include "core/io/off_format.h"
+#include "core/io/ply_format.h"
 #include "core/io/ply_mesh.h"
 #include "core/io/text_parse.h"
 
@@ -86,6 +88,17 @@ absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path, const MeshReadLim
         path, ": ", mesh->num_triangles(), " faces exceed the limit of ", limits.max_triangles));
   if (auto st = mesh->Validate(); !st.ok()) return Bad(path, st.message());
   return mesh;
+}
+
+bool PlyDeclaresFaces(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string head(64 * 1024, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  auto h = ParsePlyHeader(head, UINT64_MAX, path);
+  if (!h.ok()) return false;
+  const int face = h->FindElement("face");
+  return face >= 0 && h->elements[face].count > 0;
 }
 
 absl::Status WriteMesh(const std::string& path, const TriangleMesh& mesh) {

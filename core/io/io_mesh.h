@@ -20,6 +20,10 @@ namespace surfinspect {
 // no triangles, non-finite vertices, only degenerate triangles, limits.
 absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path, const MeshReadLimits& limits = {});
 
+// True when the file's PLY header parses and declares a face element with
+// rows: such a PLY is a mesh, any other a point cloud.
+bool PlyDeclaresFaces(const std::string& path);
+
 enum class MeshFormat { kStlBinary, kStlAscii, kObj, kPlyBinary, kPlyAscii };
 
 // Format from the extension when omitted (.stl binary, .obj, .ply binary).
