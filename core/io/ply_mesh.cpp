@@ -4,6 +4,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/io/ply_format.h"
+#include "core/io/ply_rows.h"
 #include "core/io/polygon_mesh.h"
 #include "core/io/text_parse.h"
 

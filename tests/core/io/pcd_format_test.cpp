@@ -1,3 +1,5 @@
+// Tests core/io/pcd_format.cpp (the header) and core/io/pcd_data.cpp (the
+// data section, all three encodings) through ParsePcd.
 #include "core/io/pcd_format.h"
 
 #include <gtest/gtest.h>

@@ -1,5 +1,6 @@
-// Tests core/io/ply_format.cpp (the header parser and row reader, through
-// the cloud reader that uses them) and core/io/ply_cloud.cpp.
+// Tests core/io/ply_format.cpp (the header parser), core/io/ply_rows.cpp
+// (the row reader), through the cloud reader that uses them, and
+// core/io/ply_cloud.cpp.
 #include "core/io/ply_cloud.h"
 
 #include <gtest/gtest.h>
