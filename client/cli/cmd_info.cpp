@@ -34,16 +34,12 @@ void Info(const std::string& path) {
     return;
   }
   // PLY may be a mesh or a cloud: a file with faces is a mesh.
-  if (ext == "ply") {
-    auto mesh = ReadMesh(path);
-    if (!mesh.ok()) {
-      auto cloud = ReadPointCloud(path);
-      if (!cloud.ok()) throw CommandFailed(std::string(mesh.status().message()));
-      std::printf("file: %s\ntype: point cloud\npoints: %zu\nvalid: %zu\norganized: no\n",
-                  path.c_str(), cloud->size(), cloud->CountValid());
-      PrintBounds(ComputeBounds(*cloud));
-      return;
-    }
+  if (ext == "ply" && !PlyDeclaresFaces(path)) {
+    const PointCloud cloud = Take(ReadPointCloud(path));
+    std::printf("file: %s\ntype: point cloud\npoints: %zu\nvalid: %zu\norganized: no\n",
+                path.c_str(), cloud.size(), cloud.CountValid());
+    PrintBounds(ComputeBounds(cloud));
+    return;
   }
   const TriangleMesh mesh = Take(ReadMesh(path));
   const MeshTopology topo = AnalyzeTopology(mesh);

@@ -11,6 +11,11 @@
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "core/io/atomic_file.h"
+#include "core/io/mesh_precheck.h"
+#include "core/io/off_format.h"
+#include "core/io/ply_format.h"
+#include "core/io/ply_mesh.h"
+#include "core/io/text_parse.h"
 
 namespace surfinspect {
 namespace {
@@ -24,19 +29,11 @@ std::string Extension(const std::string& path) {
   return dot == std::string::npos ? "" : absl::AsciiStrToLower(path.substr(dot + 1));
 }
 
-}  // namespace
-
-absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path, const MeshReadLimits& limits) {
-  std::ifstream probe(path, std::ios::binary | std::ios::ate);
-  if (!probe) return absl::NotFoundError(absl::StrCat(path, ": cannot open"));
-  const auto size = static_cast<uint64_t>(probe.tellg());
-  if (size == 0) return Bad(path, "file is empty");
-  if (size > limits.max_file_bytes)
-    return absl::ResourceExhaustedError(
-        absl::StrCat(path, ": file exceeds ", limits.max_file_bytes, " bytes"));
+// STL and OBJ, after mesh_precheck.h passed them: Assimp merges identical
+// vertices by position alone once normals, UVs and colours are dropped (STL
+// stores a face normal with every corner).
+absl::StatusOr<TriangleMesh> ImportWithAssimp(const std::string& path) {
   Assimp::Importer importer;
-  // Drop normals/UVs/colours first so JoinIdenticalVertices merges by
-  // position alone (STL stores a face normal with every corner).
   importer.SetPropertyInteger(
       AI_CONFIG_PP_RVC_FLAGS,
       aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS | aiComponent_COLORS |
@@ -52,11 +49,6 @@ absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path, const MeshReadLim
   }
   if (!scene) return Bad(path, absl::StrCat("cannot import: ", importer.GetErrorString()));
   TriangleMesh mesh;
-  uint64_t tri_total = 0;
-  for (unsigned m = 0; m < scene->mNumMeshes; ++m) tri_total += scene->mMeshes[m]->mNumFaces;
-  if (tri_total > limits.max_triangles)
-    return absl::ResourceExhaustedError(
-        absl::StrCat(path, ": ", tri_total, " faces exceed the limit of ", limits.max_triangles));
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
     const aiMesh* am = scene->mMeshes[m];
     const auto base = static_cast<uint32_t>(mesh.vertices.size());
@@ -69,8 +61,44 @@ absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path, const MeshReadLim
           {base + face.mIndices[0], base + face.mIndices[1], base + face.mIndices[2]});
     }
   }
-  if (auto st = mesh.Validate(); !st.ok()) return Bad(path, st.message());
   return mesh;
+}
+
+absl::StatusOr<TriangleMesh> ReadByFormat(const std::string& path, const std::string& ext,
+                                          const MeshReadLimits& limits) {
+  if (ext != "stl" && ext != "obj" && ext != "ply" && ext != "off")
+    return Bad(path, "unknown mesh format (expected .stl, .obj, .ply or .off)");
+  auto bytes = ReadWholeFile(path, limits.max_file_bytes);
+  if (!bytes.ok()) return bytes.status();
+  if (ext == "ply") return ParsePlyMesh(*bytes, limits, path);
+  if (ext == "off") return ParseOff(*bytes, limits, path);
+  const absl::Status check =
+      ext == "stl" ? CheckStl(*bytes, limits, path) : CheckObj(*bytes, limits, path);
+  if (!check.ok()) return check;
+  return ImportWithAssimp(path);
+}
+
+}  // namespace
+
+absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path, const MeshReadLimits& limits) {
+  auto mesh = ReadByFormat(path, Extension(path), limits);
+  if (!mesh.ok()) return mesh.status();
+  if (mesh->num_triangles() > limits.max_triangles)
+    return absl::ResourceExhaustedError(absl::StrCat(
+        path, ": ", mesh->num_triangles(), " faces exceed the limit of ", limits.max_triangles));
+  if (auto st = mesh->Validate(); !st.ok()) return Bad(path, st.message());
+  return mesh;
+}
+
+bool PlyDeclaresFaces(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string head(64 * 1024, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  auto h = ParsePlyHeader(head, UINT64_MAX, path);
+  if (!h.ok()) return false;
+  const int face = h->FindElement("face");
+  return face >= 0 && h->elements[face].count > 0;
 }
 
 absl::Status WriteMesh(const std::string& path, const TriangleMesh& mesh) {

@@ -1,25 +1,28 @@
-// Mesh files through Assimp: STL (ascii and binary), OBJ, PLY and OFF are
-// read; STL, OBJ and PLY are written. On read, per-vertex attributes are
+// Mesh files: STL (ascii and binary), OBJ, PLY and OFF are read; STL, OBJ
+// and PLY are written, through Assimp. PLY and OFF are read by our own
+// parsers (ply_mesh.h, off_format.h); STL and OBJ by Assimp after a strict
+// check of the bytes (mesh_precheck.h). On read, per-vertex attributes are
 // dropped and identical vertex positions merged, so an STL (which stores
 // three vertices per facet) comes back with shared vertices and its
-// topology (closed or open) can be analysed.
+// topology (closed or open) can be analysed. Every path gives the mesh the
+// Assimp import gave.
 #pragma once
 
 #include <string>
 
 #include "absl/status/statusor.h"
+#include "core/io/read_limits.h"
 #include "core/types/triangle_mesh.h"
 
 namespace surfinspect {
 
-struct MeshReadLimits {
-  uint64_t max_file_bytes = uint64_t{2} << 30;
-  uint64_t max_triangles = 50'000'000;
-};
-
 // Fails with a message naming the file for: unreadable or truncated files,
 // no triangles, non-finite vertices, only degenerate triangles, limits.
 absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path, const MeshReadLimits& limits = {});
+
+// True when the file's PLY header parses and declares a face element with
+// rows: such a PLY is a mesh, any other a point cloud.
+bool PlyDeclaresFaces(const std::string& path);
 
 enum class MeshFormat { kStlBinary, kStlAscii, kObj, kPlyBinary, kPlyAscii };
 

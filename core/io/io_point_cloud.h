@@ -1,26 +1,24 @@
-// Point-cloud files through PCL's readers and writers (the only translation
-// unit that includes PCL's I/O headers, to keep builds fast).
+// Point-cloud files: read by our own parsers (pcd_format.h, ply_cloud.h),
+// written through PCL's writers (this is the only translation unit that
+// includes PCL's I/O headers, to keep builds fast).
 //
 // Supported: PCD (ascii, binary, binary_compressed; organized grids and NaN
 // pixels kept bit-exact) and PLY (ascii, binary little/big endian). The x, y,
-// z fields may be float32 or float64; other fields are ignored. Every file
-// header is checked against the file size before PCL parses it, because
-// PCL's parsers trust declared counts (see FIELD-NOTES: OSS-Fuzz reports).
+// z fields may be float32 or float64; other fields are ignored. PCL's
+// readers are not used: they trust declared counts and crash or abort on
+// malformed headers, while ours refuse them with a message.
 #pragma once
 
 #include <cstdint>
 #include <string>
 
 #include "absl/status/statusor.h"
+#include "core/io/read_limits.h"
 #include "core/types/point_cloud.h"
 
 namespace surfinspect {
 
 enum class PcdEncoding { kAscii, kBinary, kBinaryCompressed };
-
-struct CloudReadLimits {
-  uint64_t max_points = 200'000'000;  // refuse larger declared counts
-};
 
 // Dispatches on the extension (.pcd or .ply, case-insensitive).
 absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path,

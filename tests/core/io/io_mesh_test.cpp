@@ -140,3 +140,26 @@ TEST(WriteMesh, RefusesInvalidMesh) {
 
 }  // namespace
 }  // namespace surfinspect
+
+namespace surfinspect {
+namespace {
+
+TEST(PlyDeclaresFaces, OnlyAFaceElementWithRowsMakesAMesh) {
+  testing::TempDir dir;
+  const std::string v = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
+  const std::string f = "property list uchar int vertex_indices\n";
+  WriteBytes(dir.File("m.ply"),
+             "ply\nformat ascii 1.0\n" + v + "element face 1\n" + f + "end_header\n");
+  WriteBytes(dir.File("c.ply"),
+             "ply\nformat ascii 1.0\n" + v + "element face 0\n" + f + "end_header\n");
+  WriteBytes(dir.File("p.ply"), "ply\nformat ascii 1.0\n" + v + "end_header\n");
+  WriteBytes(dir.File("bad.ply"), "ply\nformat ascii 1.0\n" + v + "element face 1\n" + f);
+  EXPECT_TRUE(PlyDeclaresFaces(dir.File("m.ply")));
+  EXPECT_FALSE(PlyDeclaresFaces(dir.File("c.ply")));
+  EXPECT_FALSE(PlyDeclaresFaces(dir.File("p.ply")));
+  EXPECT_FALSE(PlyDeclaresFaces(dir.File("bad.ply")));
+  EXPECT_FALSE(PlyDeclaresFaces(dir.File("missing.ply")));
+}
+
+}  // namespace
+}  // namespace surfinspect
