@@ -36,14 +36,25 @@ class Neighbourhood {
   virtual double Area(std::size_t i) const = 0;
 };
 
-// Organized grid: a 5 x 5 window for the median, 8-neighbours for links.
+// Organized grid: the pixels of a square window whose measured points lie
+// within reach, for the median; 8-neighbours within the link distance for
+// links. Measured (not closest CAD) points: a mixed pixel hanging between two
+// surfaces has its closest CAD point on the surface, but few measured points
+// near it, so it gets no estimate of its own.
 class GridNeighbourhood final : public Neighbourhood {
  public:
-  GridNeighbourhood(const ErrorMapResult& em, uint32_t width, uint32_t height, float link_mm,
-                    double spacing_mm)
-      : em_(em), w_(width), h_(height), link_(link_mm), spacing_(spacing_mm) {}
+  GridNeighbourhood(const ErrorMapResult& em, const PointCloud& cloud, float radius_mm,
+                    float link_mm, double spacing_mm)
+      : em_(em),
+        pts_(cloud.points),
+        w_(cloud.width),
+        h_(cloud.height),
+        half_(std::clamp(static_cast<long>(std::ceil(radius_mm / spacing_mm)), 1L, 4L)),
+        radius_(radius_mm),
+        link_(link_mm),
+        spacing_(spacing_mm) {}
   void Local(std::size_t i, std::vector<uint32_t>& out) const override {
-    Window(i, 2, 2 * link_, out);
+    Window(i, half_, radius_, out);
   }
   void Links(std::size_t i, std::vector<uint32_t>& out) const override { Window(i, 1, link_, out); }
   double Area(std::size_t i) const override {
@@ -54,14 +65,16 @@ class GridNeighbourhood final : public Neighbourhood {
   }
 
  private:
+  bool Near(std::size_t i, std::size_t j, float reach) const {
+    return Matched(em_, j) && (pts_[i] - pts_[j]).norm() <= reach;
+  }
   void Window(std::size_t i, long half, float reach, std::vector<uint32_t>& out) const {
     out.clear();
     const long r = static_cast<long>(i / w_), c = static_cast<long>(i % w_);
     for (long rr = std::max(0L, r - half); rr <= std::min<long>(h_ - 1, r + half); ++rr)
       for (long cc = std::max(0L, c - half); cc <= std::min<long>(w_ - 1, c + half); ++cc) {
         const std::size_t j = static_cast<std::size_t>(rr) * w_ + static_cast<std::size_t>(cc);
-        if (Matched(em_, j) && Distance(em_, i, j) <= reach)
-          out.push_back(static_cast<uint32_t>(j));
+        if (Near(i, j, reach)) out.push_back(static_cast<uint32_t>(j));
       }
   }
   // Central (else one-sided) difference of the closest points along (dr, dc).
@@ -70,7 +83,7 @@ class GridNeighbourhood final : public Neighbourhood {
       const long rr = r + k * dr, cc = c + k * dc;
       if (rr < 0 || cc < 0 || rr >= static_cast<long>(h_) || cc >= static_cast<long>(w_)) return -1;
       const std::size_t j = static_cast<std::size_t>(rr) * w_ + static_cast<std::size_t>(cc);
-      return Matched(em_, j) && Distance(em_, i, j) <= link_ ? static_cast<long>(j) : -1;
+      return Near(i, j, link_) ? static_cast<long>(j) : -1;
     };
     const long a = at(-1), b = at(1);
     const auto& cp = em_.closest_point;
@@ -80,22 +93,24 @@ class GridNeighbourhood final : public Neighbourhood {
     return Eigen::Vector3f::Zero();
   }
   const ErrorMapResult& em_;
+  const std::vector<Eigen::Vector3f>& pts_;
   uint32_t w_, h_;
-  float link_;
+  long half_;
+  float radius_, link_;
   double spacing_;
 };
 
-// Unorganized: cells of edge `radius`, so every neighbour within the radius
-// is in the 27 cells around a point's own.
+// Unorganized: cells of edge `radius` over the measured points, so every
+// neighbour within the radius is in the 27 cells around a point's own.
 class CellNeighbourhood final : public Neighbourhood {
  public:
-  CellNeighbourhood(const ErrorMapResult& em, float radius_mm, float link_mm)
-      : em_(em), cell_(radius_mm), radius_(radius_mm), link_(link_mm) {
+  CellNeighbourhood(const ErrorMapResult& em, const PointCloud& cloud, float radius_mm,
+                    float link_mm)
+      : em_(em), pts_(cloud.points), cell_(radius_mm), radius_(radius_mm), link_(link_mm) {
     for (std::size_t i = 0; i < em.triangle_id.size(); ++i)
       if (Matched(em, i)) order_.push_back(static_cast<uint32_t>(i));
     std::vector<uint64_t> keys(order_.size());
-    for (std::size_t k = 0; k < order_.size(); ++k)
-      keys[k] = Key(em.closest_point[order_[k]], 0, 0, 0);
+    for (std::size_t k = 0; k < order_.size(); ++k) keys[k] = Key(pts_[order_[k]], 0, 0, 0);
     std::vector<uint32_t> perm(order_.size());
     std::iota(perm.begin(), perm.end(), 0u);
     std::sort(perm.begin(), perm.end(), [&](uint32_t a, uint32_t b) {
@@ -133,18 +148,19 @@ class CellNeighbourhood final : public Neighbourhood {
   }
   void Within(std::size_t i, float reach, std::vector<uint32_t>& out) const {
     out.clear();
-    const Eigen::Vector3f& p = em_.closest_point[i];
+    const Eigen::Vector3f& p = pts_[i];
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dz = -1; dz <= 1; ++dz) {
           const auto it = cells_.find(Key(p, dx, dy, dz));
           if (it == cells_.end()) continue;
           for (uint32_t k = start_[it->second]; k < start_[it->second + 1]; ++k)
-            if (Distance(em_, i, order_[k]) <= reach) out.push_back(order_[k]);
+            if ((pts_[i] - pts_[order_[k]]).norm() <= reach) out.push_back(order_[k]);
         }
     std::sort(out.begin(), out.end());  // a fixed order, whatever the hash map's
   }
   const ErrorMapResult& em_;
+  const std::vector<Eigen::Vector3f>& pts_;
   float cell_, radius_, link_;
   std::vector<uint32_t> order_, start_;
   std::unordered_map<uint64_t, uint32_t> cells_;
@@ -159,9 +175,13 @@ double Median(std::vector<double>& v) {
          (v[mid] + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid)));
 }
 
-// Spacing: the median distance from a sample of points to their nearest
-// other point (organized: the right or lower neighbour pixel).
+// Spacing: organized, the median distance from a sample of measured points
+// to their right or lower neighbour pixel; unorganized, sqrt of the surface
+// area per point, pi R^2 / (points within R = 2 mm), median over a sample,
+// so that overlapping views (interleaved, nearest neighbours far closer
+// than the sampling) count as the denser sampling they are.
 double EstimateSpacing(const ErrorMapResult& em, const PointCloud& cloud) {
+  const auto& p = cloud.points;
   std::vector<double> d;
   const std::size_t n = em.triangle_id.size();
   const std::size_t stride = std::max<std::size_t>(1, n / 20000);
@@ -170,24 +190,21 @@ double EstimateSpacing(const ErrorMapResult& em, const PointCloud& cloud) {
     for (std::size_t i = 0; i + w < n; i += stride) {
       if (!Matched(em, i)) continue;
       double best = INFINITY;
-      if ((i + 1) % w != 0 && Matched(em, i + 1)) best = Distance(em, i, i + 1);
-      if (Matched(em, i + w)) best = std::min<double>(best, Distance(em, i, i + w));
+      if ((i + 1) % w != 0 && Matched(em, i + 1)) best = (p[i] - p[i + 1]).norm();
+      if (Matched(em, i + w)) best = std::min<double>(best, (p[i] - p[i + w]).norm());
       if (std::isfinite(best) && best > 0) d.push_back(best);
     }
   } else {
-    CellNeighbourhood coarse(em, 2.0f, 2.0f);  // spacings up to 2 mm
+    constexpr float kR = 2.0f;
+    CellNeighbourhood coarse(em, cloud, kR, kR);
     std::vector<uint32_t> near;
     for (std::size_t k = 0; k < coarse.order().size(); k += stride) {
-      const uint32_t i = coarse.order()[k];
-      coarse.Local(i, near);
-      double best = INFINITY;
-      for (uint32_t j : near)
-        if (j != i && Distance(em, i, j) > 0) best = std::min<double>(best, Distance(em, i, j));
-      if (std::isfinite(best)) d.push_back(best);
+      coarse.Local(coarse.order()[k], near);
+      d.push_back(std::sqrt(M_PI * kR * kR / static_cast<double>(near.size())));
     }
   }
   const double m = Median(d);
-  return std::isfinite(m) ? m : 1.0;
+  return std::isfinite(m) && m > 0 ? m : 1.0;
 }
 
 // The median of the deviations around each matched point (NaN: too few).
@@ -448,14 +465,15 @@ absl::StatusOr<DefectsResult> FindDefects(const ErrorMapResult& em, const PointC
   std::vector<uint32_t> order;
   if (out.organized_path) {
     out.link_mm = settings.grid_link_spacings * out.spacing_mm;
-    nb = std::make_unique<GridNeighbourhood>(em, cloud.width, cloud.height,
-                                             static_cast<float>(out.link_mm), out.spacing_mm);
+    nb = std::make_unique<GridNeighbourhood>(
+        em, cloud, static_cast<float>(settings.neighbourhood_spacings * out.spacing_mm),
+        static_cast<float>(out.link_mm), out.spacing_mm);
     for (std::size_t i = 0; i < em.triangle_id.size(); ++i)
       if (Matched(em, i)) order.push_back(static_cast<uint32_t>(i));
   } else {
     out.link_mm = settings.link_spacings * out.spacing_mm;
     auto cells = std::make_unique<CellNeighbourhood>(
-        em, static_cast<float>(settings.neighbourhood_spacings * out.spacing_mm),
+        em, cloud, static_cast<float>(settings.neighbourhood_spacings * out.spacing_mm),
         static_cast<float>(out.link_mm));
     order = cells->order();
     nb = std::move(cells);

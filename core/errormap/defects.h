@@ -4,13 +4,15 @@
 // measured values; they change none of them.
 //
 // The steps, each from a standard source:
-//  1. Neighbourhoods on the surface. Organized cloud: a 5 x 5 pixel window
-//     (and 8-neighbours for linking), a neighbour counting only when its
-//     closest CAD point is within reach in 3D, so a window never straddles a
-//     depth jump. Unorganized (e.g. merged views): a uniform cell grid over
-//     the closest CAD points, cells one neighbourhood radius wide, searched
-//     3 x 3 x 3 (the fixed-radius near-neighbour grid, Bentley & Friedman,
-//     "Data structures for range searching", Computing Surveys 1979).
+//  1. Neighbourhoods on the surface: the measured points within a radius r
+//     (2.5 sampling spacings) in 3D. Organized cloud: searched in a pixel
+//     window around the point, 8-neighbours for linking. Unorganized (e.g.
+//     merged views): a uniform cell grid, cells r wide, searched 3 x 3 x 3
+//     (the fixed-radius near-neighbour grid, Bentley & Friedman, "Data
+//     structures for range searching", Computing Surveys 1979). A window
+//     never straddles a depth jump, and a mixed pixel hanging between two
+//     surfaces (kept by the filter through a chain of links) has too few
+//     neighbours for an estimate, so a band of them is never a defect.
 //  2. A robust local estimate: the median of the signed deviations in each
 //     point's neighbourhood (Tukey's running median, "Exploratory Data
 //     Analysis", 1977). Sensor noise of sigma shrinks to ~1.25 sigma/sqrt(n)
@@ -69,16 +71,19 @@ struct DefectSettings {
   // Sampling spacing of the cloud on the surface, mm; 0 = estimated (the
   // median distance between neighbouring closest CAD points).
   double spacing_mm = 0;
-  // Unorganized path: the median's neighbourhood radius and the link
-  // distance, in spacings (2.5: ~20 points per neighbourhood).
+  // The median's neighbourhood radius in spacings (2.5: ~20 points), and the
+  // unorganized path's link distance.
   double neighbourhood_spacings = 2.5;
   double link_spacings = 2.0;
   // Organized path: the link distance between 8-neighbours, in spacings:
   // generous (1 mm at the demo's 0.25 mm pitch), so steep walls stay
   // linked, and still below the depth jumps between surfaces.
   double grid_link_spacings = 4.0;
-  int min_neighbours = 5;  // fewer in the neighbourhood: no robust estimate, never a defect
-  int threads = 0;         // 0 = all cores; the result is the same for any value
+  // Fewer measured points within r: no robust estimate, never a defect. 8 of
+  // the ~20 a surface sampled at the spacing has; a surface seen at grazing
+  // incidence (spacing > ~1.5x the estimate) gets no estimate either.
+  int min_neighbours = 8;
+  int threads = 0;  // 0 = all cores; the result is the same for any value
 };
 
 struct DefectsResult {
@@ -90,8 +95,8 @@ struct DefectsResult {
   std::size_t rejected_patches = 0;  // patches below min_area_mm2
 };
 
-// `cloud` gives the layout (organized width x height or not) of the points
-// the error map was computed on; its coordinates are not read. `part` is
+// `cloud` is the cloud the error map was computed on (any frame: only
+// distances between its points are used, and its grid layout). `part` is
 // the mesh of the error map; `plan`, when given, names each defect's region.
 // InvalidArgument for bad rules or mismatched sizes.
 absl::StatusOr<DefectsResult> FindDefects(const ErrorMapResult& error_map, const PointCloud& cloud,

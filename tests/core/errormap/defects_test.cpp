@@ -1,0 +1,240 @@
+// Defect detection (core/errormap/defects.cpp) against ground truth: demo
+// scans (noise 0.015 mm, pulses, stripes) through the production filter and
+// the error map, with Gaussian dents and bumps 0.05-0.5 mm deep and 3-8 mm in
+// radius planted on the pillar's ridge; and clean scans for false defects.
+#include "core/errormap/defects.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <iostream>
+#include <random>
+
+#include "core/filter/link_clustering.h"
+#include "core/simulation/demo_cell.h"
+#include "core/simulation/scan_simulator.h"
+#include "core/types/transform.h"
+#include "tests/support/test_meshes.h"
+
+namespace surfinspect {
+namespace {
+
+// The ridge of MakePillarMesh(300): z = 60 - 3 (x / 150)^2.
+double RidgeZ(double x) { return 60.0 - 3.0 * (x / 150.0) * (x / 150.0); }
+
+// The plan used throughout: 0.03 mm is 2 sigma of the raw noise but ~7
+// sigma of the 5 x 5 median, and low enough that a 0.05 mm dent of 3 mm
+// radius still has ~7 mm^2 above it.
+DefectRules Rules() {
+  DefectRules r;
+  r.threshold_mm = 0.03;
+  r.min_area_mm2 = 3.0;
+  return r;
+}
+
+struct MappedScan {
+  PointCloud cloud_in_world;  // filtered
+  ErrorMapResult error_map;
+};
+
+class DefectsGroundTruth : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    cell_ = new DemoCell(MakeDemoCell());
+    auto index = MeshIndex::Build(cell_->part);
+    ASSERT_TRUE(index.ok()) << index.status();
+    index_ = index->release();
+  }
+  static void TearDownTestSuite() {
+    delete index_;
+    delete cell_;
+  }
+
+  // Simulate view `v` with `defects`, filter (ForInspection), map.
+  static MappedScan Scan(std::size_t v, const std::vector<SurfaceDefect>& defects, uint64_t seed) {
+    const DemoViewpoint& vp = cell_->viewpoints[v];
+    ScanOptions opt;
+    opt.noise_sigma_mm = 0.015;
+    opt.pulse_fraction = 0.003;
+    opt.stripes = true;
+    opt.defects = defects;
+    opt.seed = seed;
+    auto scan = SimulateScan(cell_->part, cell_->world_from_part, vp.world_from_sensor,
+                             cell_->intrinsics, opt);
+    EXPECT_TRUE(scan.ok()) << scan.status();
+    auto clusters = ClusterLinks(scan->cloud_in_sensor, LinkClusteringSettings::ForInspection());
+    EXPECT_TRUE(clusters.ok()) << clusters.status();
+    auto filtered = ApplyFilter(scan->cloud_in_sensor, *clusters);
+    EXPECT_TRUE(filtered.ok());
+    MappedScan out;
+    out.cloud_in_world = TransformCloud(*filtered, vp.world_from_sensor);
+    ErrorMapSettings es;
+    es.tolerance_mm = 0.3;
+    auto em = ComputeErrorMap(*index_, out.cloud_in_world, cell_->world_from_part, es);
+    EXPECT_TRUE(em.ok()) << em.status();
+    out.error_map = *std::move(em);
+    return out;
+  }
+
+  static inline DemoCell* cell_ = nullptr;
+  static inline MeshIndex* index_ = nullptr;
+};
+
+SurfaceDefect Planted(double x, double y, double depth, double radius) {
+  SurfaceDefect d;
+  d.center_in_part = {x, y, RidgeZ(x)};
+  d.depth_mm = depth;
+  d.radius_mm = radius;
+  return d;
+}
+
+struct Tally {
+  int planted_deep = 0, found_deep = 0, planted_shallow = 0, found_shallow = 0, false_defects = 0;
+  double worst_centroid_mm = 0, worst_peak_deep_mm = 0;
+};
+
+// Matches planted to found (same kind, centroid within 3 mm) and checks
+// centroid and peak; found defects matching nothing are false.
+void Score(const std::vector<SurfaceDefect>& planted, const DefectsResult& found, Tally& t) {
+  std::vector<bool> used(found.defects.size(), false);
+  for (const SurfaceDefect& p : planted) {
+    const bool deep = std::abs(p.depth_mm) >= 0.1;
+    (deep ? t.planted_deep : t.planted_shallow)++;
+    const DefectKind kind = p.depth_mm > 0 ? DefectKind::kDent : DefectKind::kBump;
+    int best = -1;
+    double best_d = 3.0;
+    for (std::size_t k = 0; k < found.defects.size(); ++k) {
+      const double d = (found.defects[k].centroid_mm - p.center_in_part).norm();
+      if (!used[k] && found.defects[k].kind == kind && d < best_d)
+        best = static_cast<int>(k), best_d = d;
+    }
+    if (best < 0) {
+      std::cout << "  missed depth " << p.depth_mm << " radius " << p.radius_mm << "\n";
+      continue;
+    }
+    used[static_cast<std::size_t>(best)] = true;
+    const Defect& f = found.defects[static_cast<std::size_t>(best)];
+    (deep ? t.found_deep : t.found_shallow)++;
+    const double peak_error = std::abs(f.peak_mm - (-p.depth_mm));
+    std::cout << "  depth " << p.depth_mm << " r " << p.radius_mm << ": peak " << f.peak_mm
+              << " (err " << peak_error * 1000 << " um, fitted " << f.peak_fitted
+              << "), centroid err " << best_d << " mm, area " << f.area_mm2 << " mm2, extent "
+              << f.extent_mm << "\n";
+    t.worst_centroid_mm = std::max(t.worst_centroid_mm, best_d);
+    if (deep) t.worst_peak_deep_mm = std::max(t.worst_peak_deep_mm, peak_error);
+  }
+  for (std::size_t k = 0; k < found.defects.size(); ++k)
+    if (!used[k]) {
+      ++t.false_defects;
+      std::cout << "  false defect at " << found.defects[k].centroid_mm.transpose() << " peak "
+                << found.defects[k].peak_mm << " area " << found.defects[k].area_mm2 << " points "
+                << found.defects[k].points << " extent " << found.defects[k].extent_mm << " fitted "
+                << found.defects[k].peak_fitted << " rms " << found.defects[k].fit_rms_mm
+                << " sigma " << found.defects[k].fit_sigma_mm << "\n";
+    }
+}
+
+// Six defects along the ridge per scan, 36 mm apart so their profiles do
+// not overlap; depths and radii cover 0.05-0.5 mm and 3-8 mm, both kinds.
+std::vector<std::vector<SurfaceDefect>> PlantedSets() {
+  const double depth[4][6] = {{0.05, -0.06, 0.07, -0.08, 0.09, -0.10},
+                              {-0.055, 0.065, -0.075, 0.085, -0.095, 0.12},
+                              {0.15, -0.2, 0.25, -0.3, 0.4, -0.5},
+                              {-0.11, 0.13, -0.18, 0.35, -0.45, 0.052}};
+  const double radius[6] = {3, 4, 5, 6, 7, 8};
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> uy(-12, 12);
+  std::vector<std::vector<SurfaceDefect>> sets(4);
+  for (int s = 0; s < 4; ++s)
+    for (int k = 0; k < 6; ++k)
+      sets[s].push_back(Planted(-90 + 36 * k, uy(rng), depth[s][k], radius[(k + s) % 6]));
+  return sets;
+}
+
+TEST_F(DefectsGroundTruth, FindsPlantedDentsAndBumpsOnSingleViews) {
+  Tally t;
+  const auto sets = PlantedSets();
+  for (std::size_t s = 0; s < sets.size(); ++s) {
+    const MappedScan m = Scan(2, sets[s], 300 + s);
+    const auto t0 = std::chrono::steady_clock::now();
+    auto found = FindDefects(m.error_map, m.cloud_in_world, cell_->part, Rules());
+    ASSERT_TRUE(found.ok()) << found.status();
+    std::cout << "scan " << s << ": " << found->defects.size() << " defects, spacing "
+              << found->spacing_mm << " mm, " << found->candidate_points << " candidates, "
+              << found->rejected_patches << " small patches, "
+              << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()
+              << " s\n";
+    EXPECT_TRUE(found->organized_path);
+    Score(sets[s], *found, t);
+  }
+  std::cout << "deep found " << t.found_deep << "/" << t.planted_deep << ", shallow "
+            << t.found_shallow << "/" << t.planted_shallow << ", false " << t.false_defects
+            << ", worst centroid " << t.worst_centroid_mm << " mm, worst deep peak error "
+            << t.worst_peak_deep_mm * 1000 << " um\n";
+  EXPECT_EQ(t.found_deep, t.planted_deep);
+  EXPECT_GE(t.found_shallow, 0.9 * t.planted_shallow);
+  EXPECT_LE(t.worst_centroid_mm, 1.0);
+  EXPECT_LE(t.worst_peak_deep_mm, 0.010);
+  EXPECT_EQ(t.false_defects, 0);
+}
+
+TEST_F(DefectsGroundTruth, NoFalseDefectsOnTwentyCleanScans) {
+  int defects = 0, scans = 0;
+  std::size_t rejected = 0;
+  for (uint64_t seed = 0; seed < 4; ++seed)
+    for (std::size_t v = 0; v < cell_->viewpoints.size(); ++v) {
+      const MappedScan m = Scan(v, {}, 1000 + 10 * seed + v);
+      auto found = FindDefects(m.error_map, m.cloud_in_world, cell_->part, Rules());
+      ASSERT_TRUE(found.ok()) << found.status();
+      ++scans;
+      defects += static_cast<int>(found->defects.size());
+      rejected += found->rejected_patches;
+      for (const Defect& d : found->defects)
+        std::cout << "  false defect view " << v << " seed " << seed << " at "
+                  << d.centroid_mm.transpose() << " peak " << d.peak_mm << " area " << d.area_mm2
+                  << "\n";
+    }
+  std::cout << scans << " clean scans: " << defects << " defects, " << rejected
+            << " patches below the area rule\n";
+  EXPECT_EQ(scans, 20);
+  EXPECT_EQ(defects, 0);
+}
+
+TEST_F(DefectsGroundTruth, MergedViewsUseTheUnorganizedPath) {
+  const std::vector<SurfaceDefect> planted = {Planted(-40, 5, 0.3, 6), Planted(-10, -8, -0.15, 4),
+                                              Planted(20, 0, 0.08, 5), Planted(50, 10, 0.2, 3)};
+  std::vector<Eigen::Vector3f> merged;
+  const Eigen::Isometry3d part_from_world = cell_->world_from_part.inverse();
+  for (std::size_t v : {1, 2}) {
+    const MappedScan m = Scan(v, planted, 500 + v);
+    // The ridge around the defects only, to keep the test short.
+    for (const Eigen::Vector3f& p : m.cloud_in_world.points) {
+      if (!PointCloud::IsValid(p)) continue;
+      const Eigen::Vector3d q = part_from_world * p.cast<double>();
+      if (std::abs(q.y()) < 25 && q.x() > -65 && q.x() < 75 && q.z() > 50) merged.push_back(p);
+    }
+  }
+  const PointCloud cloud = PointCloud::Unorganized(merged);
+  ErrorMapSettings es;
+  es.tolerance_mm = 0.3;
+  auto em = ComputeErrorMap(*index_, cloud, cell_->world_from_part, es);
+  ASSERT_TRUE(em.ok()) << em.status();
+  const auto t0 = std::chrono::steady_clock::now();
+  auto found = FindDefects(*em, cloud, cell_->part, Rules());
+  ASSERT_TRUE(found.ok()) << found.status();
+  std::cout << merged.size() << " merged points: " << found->defects.size() << " defects, spacing "
+            << found->spacing_mm << " mm, "
+            << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()
+            << " s\n";
+  EXPECT_FALSE(found->organized_path);
+  Tally t;
+  Score(planted, *found, t);
+  EXPECT_EQ(t.found_deep, 3);
+  EXPECT_EQ(t.found_shallow, 1);
+  EXPECT_LE(t.worst_centroid_mm, 1.0);
+  EXPECT_LE(t.worst_peak_deep_mm, 0.010);
+  EXPECT_EQ(t.false_defects, 0);
+}
+
+}  // namespace
+}  // namespace surfinspect
