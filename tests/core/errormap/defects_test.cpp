@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <iostream>
 #include <random>
@@ -234,6 +235,127 @@ TEST_F(DefectsGroundTruth, MergedViewsUseTheUnorganizedPath) {
   EXPECT_LE(t.worst_centroid_mm, 1.0);
   EXPECT_LE(t.worst_peak_deep_mm, 0.010);
   EXPECT_EQ(t.false_defects, 0);
+}
+
+// A synthetic organized scan of the plane z = 0 at 0.25 mm pitch with noise
+// 0.015 mm, a dent and a bump, 500 single-pixel spikes and a 4 x 4 pixel
+// (1 mm^2) spatter blob.
+struct Synthetic {
+  TriangleMesh mesh;
+  PointCloud cloud;
+  ErrorMapResult error_map;
+};
+Synthetic MakeSynthetic(bool organized) {
+  Synthetic s;
+  s.mesh = testing::HeightField(0, 100, 0, 100, 11, 11, [](double, double) { return 0.0; });
+  constexpr uint32_t kSide = 360;
+  s.cloud = PointCloud::Organized(kSide, kSide);
+  std::mt19937_64 rng(17);
+  std::normal_distribution<double> noise(0, 0.015);
+  auto gauss = [](double x, double y, double cx, double cy, double a, double sigma) {
+    return a * std::exp(-((x - cx) * (x - cx) + (y - cy) * (y - cy)) / (2 * sigma * sigma));
+  };
+  for (uint32_t r = 0; r < kSide; ++r)
+    for (uint32_t c = 0; c < kSide; ++c) {
+      const double x = 5 + 0.25 * c, y = 5 + 0.25 * r;
+      double z = noise(rng) + gauss(x, y, 30, 30, -0.2, 2.0) + gauss(x, y, 70, 30, 0.15, 3.0);
+      if (c >= 280 && c < 284 && r >= 260 && r < 264) z += 0.4;  // spatter
+      s.cloud.points[r * kSide + c] = Eigen::Vector3d(x, y, z).cast<float>();
+    }
+  std::uniform_int_distribution<uint32_t> pixel(0, kSide * kSide - 1);
+  for (int k = 0; k < 500; ++k) s.cloud.points[pixel(rng)].z() += 0.5f;
+  if (!organized) {
+    std::shuffle(s.cloud.points.begin(), s.cloud.points.end(), rng);
+    s.cloud = PointCloud::Unorganized(s.cloud.points);
+  }
+  auto index = MeshIndex::Build(s.mesh);
+  EXPECT_TRUE(index.ok());
+  auto em = ComputeErrorMap(**index, s.cloud, Eigen::Isometry3d::Identity(), {});
+  EXPECT_TRUE(em.ok()) << em.status();
+  s.error_map = *std::move(em);
+  return s;
+}
+
+// Area where a Gaussian of amplitude a and width sigma exceeds thr.
+double AreaAbove(double a, double sigma, double thr) {
+  return M_PI * 2 * sigma * sigma * std::log(std::abs(a) / thr);
+}
+
+void ExpectDentAndBump(const DefectsResult& r) {
+  ASSERT_EQ(r.defects.size(), 2u) << "spikes and the 1 mm^2 blob are no defects";
+  EXPECT_GE(r.rejected_patches, 1u) << "the blob is a patch below the area rule";
+  const Defect& dent = r.defects[0];  // |peak| 0.2 first
+  const Defect& bump = r.defects[1];
+  EXPECT_EQ(dent.id, 1);
+  EXPECT_EQ(dent.kind, DefectKind::kDent);
+  EXPECT_EQ(bump.kind, DefectKind::kBump);
+  EXPECT_LT((dent.centroid_mm - Eigen::Vector3d(30, 30, 0)).norm(), 0.2);
+  EXPECT_LT((bump.centroid_mm - Eigen::Vector3d(70, 30, 0)).norm(), 0.2);
+  EXPECT_EQ(dent.centroid_mm.z(), 0.0) << "on the CAD surface";
+  EXPECT_NEAR(dent.peak_mm, -0.2, 0.005);
+  EXPECT_NEAR(bump.peak_mm, 0.15, 0.005);
+  EXPECT_TRUE(dent.peak_fitted && bump.peak_fitted);
+  EXPECT_NEAR(dent.fit_sigma_mm, 2.0, 0.1);
+  EXPECT_NEAR(dent.area_mm2, AreaAbove(0.2, 2.0, 0.03), 0.1 * AreaAbove(0.2, 2.0, 0.03));
+  EXPECT_NEAR(bump.area_mm2, AreaAbove(0.15, 3.0, 0.03), 0.1 * AreaAbove(0.15, 3.0, 0.03));
+  // The patch is a disc: its extent is its diameter.
+  EXPECT_NEAR(dent.extent_mm, 2 * std::sqrt(AreaAbove(0.2, 2.0, 0.03) / M_PI), 0.5);
+}
+
+TEST(Defects, SpikesAndSmallBlobsAreNoDefectsOnTheGrid) {
+  const Synthetic s = MakeSynthetic(true);
+  auto r = FindDefects(s.error_map, s.cloud, s.mesh, Rules());
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_TRUE(r->organized_path);
+  EXPECT_NEAR(r->spacing_mm, 0.25, 0.005);
+  ExpectDentAndBump(*r);
+}
+
+TEST(Defects, TheUnorganizedPathFindsTheSame) {
+  const Synthetic s = MakeSynthetic(false);
+  auto r = FindDefects(s.error_map, s.cloud, s.mesh, Rules());
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_FALSE(r->organized_path);
+  EXPECT_NEAR(r->spacing_mm, 0.25, 0.02);
+  ExpectDentAndBump(*r);
+}
+
+TEST(Defects, SameResultForAnyThreadCount) {
+  const Synthetic s = MakeSynthetic(false);
+  DefectSettings one, two;
+  one.threads = 1;
+  two.threads = 2;
+  auto a = FindDefects(s.error_map, s.cloud, s.mesh, Rules(), nullptr, one);
+  auto b = FindDefects(s.error_map, s.cloud, s.mesh, Rules(), nullptr, two);
+  ASSERT_TRUE(a.ok() && b.ok());
+  ASSERT_EQ(a->defects.size(), b->defects.size());
+  for (std::size_t k = 0; k < a->defects.size(); ++k) {
+    EXPECT_EQ(a->defects[k].centroid_mm, b->defects[k].centroid_mm);
+    EXPECT_EQ(a->defects[k].peak_mm, b->defects[k].peak_mm);
+    EXPECT_EQ(a->defects[k].area_mm2, b->defects[k].area_mm2);
+  }
+}
+
+TEST(Defects, NamesTheRegionAndRefusesBadInput) {
+  const Synthetic s = MakeSynthetic(true);
+  InspectionPlan plan;
+  PlanRegion left{"left", {}, {}, 0.0};
+  left.select.box_min_mm = {0, 0, -1};
+  left.select.box_max_mm = {50, 100, 1};
+  plan.regions = {left};
+  auto rp = ResolveInspectionPlan(plan, s.mesh);
+  ASSERT_TRUE(rp.ok());
+  auto r = FindDefects(s.error_map, s.cloud, s.mesh, Rules(), &*rp);
+  ASSERT_TRUE(r.ok());
+  ASSERT_EQ(r->defects.size(), 2u);
+  EXPECT_EQ(r->defects[0].region, "left");
+  EXPECT_EQ(r->defects[1].region, "");
+  DefectRules bad = Rules();
+  bad.threshold_mm = 0;
+  EXPECT_EQ(FindDefects(s.error_map, s.cloud, s.mesh, bad).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  PointCloud shorter = PointCloud::Unorganized({Eigen::Vector3f::Zero()});
+  EXPECT_FALSE(FindDefects(s.error_map, shorter, s.mesh, Rules()).ok());
 }
 
 }  // namespace
