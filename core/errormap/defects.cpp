@@ -35,6 +35,11 @@ class Neighbourhood {
   virtual void Links(std::size_t i, std::vector<uint32_t>& out) const = 0;
   // The footprint area of point i, mm^2.
   virtual double Area(std::size_t i) const = 0;
+  // Per point: 1 unless a superset of its neighbourhood (its window, its
+  // 27 cells) holds fewer than `need` points of each sign in `hot`, in which
+  // case its median cannot pass the threshold (that needs half of its >=
+  // min_neighbours points beyond it, on one side).
+  virtual std::vector<uint8_t> MayExceed(const std::vector<int8_t>& hot, uint32_t need) const = 0;
 };
 
 // Organized grid: the pixels of a square window whose measured points lie
@@ -58,6 +63,32 @@ class GridNeighbourhood final : public Neighbourhood {
     Window(i, half_, radius_, out);
   }
   void Links(std::size_t i, std::vector<uint32_t>& out) const override { Window(i, 1, link_, out); }
+  // Window counts from summed-area tables of each sign (Crow, SIGGRAPH 1984).
+  std::vector<uint8_t> MayExceed(const std::vector<int8_t>& hot, uint32_t need) const override {
+    const std::size_t W = w_ + 1;
+    std::vector<uint32_t> pos(W * (h_ + 1), 0), neg(W * (h_ + 1), 0);
+    for (std::size_t r = 0; r < h_; ++r)
+      for (std::size_t c = 0; c < w_; ++c) {
+        const int8_t v = hot[r * w_ + c];
+        const std::size_t k = (r + 1) * W + c + 1;
+        pos[k] = pos[k - 1] + pos[k - W] - pos[k - W - 1] + (v > 0);
+        neg[k] = neg[k - 1] + neg[k - W] - neg[k - W - 1] + (v < 0);
+      }
+    std::vector<uint8_t> may(hot.size(), 0);
+    for (std::size_t r = 0; r < h_; ++r) {
+      const std::size_t r0 = r > std::size_t(half_) ? r - half_ : 0,
+                        r1 = std::min<std::size_t>(h_, r + half_ + 1);
+      for (std::size_t c = 0; c < w_; ++c) {
+        const std::size_t c0 = c > std::size_t(half_) ? c - half_ : 0,
+                          c1 = std::min<std::size_t>(w_, c + half_ + 1);
+        auto box = [&](const std::vector<uint32_t>& t) {
+          return t[r1 * W + c1] - t[r0 * W + c1] - t[r1 * W + c0] + t[r0 * W + c0];
+        };
+        may[r * w_ + c] = box(pos) >= need || box(neg) >= need;
+      }
+    }
+    return may;
+  }
   double Area(std::size_t i) const override {
     const long r = static_cast<long>(i / w_), c = static_cast<long>(i % w_);
     const Eigen::Vector3f du = Difference(i, r, c, 0, 1), dv = Difference(i, r, c, 1, 0);
@@ -127,6 +158,32 @@ class CellNeighbourhood final : public Neighbourhood {
     }
     start_.push_back(static_cast<uint32_t>(sorted.size()));
     order_ = std::move(sorted);
+    cell_key_.resize(start_.size() - 1);
+    for (const auto& [key, cell] : cells_) cell_key_[cell] = key;
+  }
+  std::vector<uint8_t> MayExceed(const std::vector<int8_t>& hot, uint32_t need) const override {
+    const std::size_t cells = start_.size() - 1;
+    std::vector<uint32_t> pos(cells, 0), neg(cells, 0);
+    for (std::size_t c = 0; c < cells; ++c)
+      for (uint32_t k = start_[c]; k < start_[c + 1]; ++k) {
+        pos[c] += hot[order_[k]] > 0;
+        neg[c] += hot[order_[k]] < 0;
+      }
+    std::vector<uint8_t> may(hot.size(), 0);
+    for (std::size_t c = 0; c < cells; ++c) {
+      uint32_t p = 0, n = 0;
+      for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dz = -1; dz <= 1; ++dz) {
+            const auto it = cells_.find(Shift(cell_key_[c], dx, dy, dz));
+            if (it == cells_.end()) continue;
+            p += pos[it->second];
+            n += neg[it->second];
+          }
+      if (p >= need || n >= need)
+        for (uint32_t k = start_[c]; k < start_[c + 1]; ++k) may[order_[k]] = 1;
+    }
+    return may;
   }
   // Matched points in cell order: the median pass walks them so that
   // consecutive queries hit the same cells.
@@ -140,6 +197,15 @@ class CellNeighbourhood final : public Neighbourhood {
   }
 
  private:
+  // The key of the cell (dx, dy, dz) cells away (the clamped edge cells of
+  // a coordinate range this wide hold no points).
+  static uint64_t Shift(uint64_t key, int dx, int dy, int dz) {
+    constexpr uint64_t kMask = (uint64_t{1} << 21) - 1;
+    auto axis = [&](int shift, int d) {
+      return ((key >> shift & kMask) + static_cast<uint64_t>(static_cast<int64_t>(d))) & kMask;
+    };
+    return axis(42, dx) << 42 | axis(21, dy) << 21 | axis(0, dz);
+  }
   uint64_t Key(const Eigen::Vector3f& p, int dx, int dy, int dz) const {
     auto axis = [&](float v, int d) {
       const long k = static_cast<long>(std::floor(v / cell_)) + d + (1L << 20);
@@ -164,6 +230,7 @@ class CellNeighbourhood final : public Neighbourhood {
   float cell_, radius_, link_;
   std::vector<uint32_t> order_, start_;
   std::unordered_map<uint64_t, uint32_t> cells_;
+  std::vector<uint64_t> cell_key_;
 };
 
 double Median(std::vector<double>& v) {
@@ -208,10 +275,18 @@ double EstimateSpacing(const ErrorMapResult& em, const PointCloud& cloud) {
   return std::isfinite(m) && m > 0 ? m : 1.0;
 }
 
-// The median of the deviations around each matched point (NaN: too few).
+// The median of the deviations around each matched point that may pass
+// the threshold (NaN elsewhere, and where there are too few neighbours).
 std::vector<float> RobustDeviation(const ErrorMapResult& em, const Neighbourhood& nb,
-                                   const std::vector<uint32_t>& order, int min_neighbours,
-                                   int threads) {
+                                   const std::vector<uint32_t>& order, float threshold,
+                                   int min_neighbours, int threads) {
+  std::vector<int8_t> hot(em.deviation_mm.size(), 0);
+  for (std::size_t i = 0; i < hot.size(); ++i) {
+    const float d = em.deviation_mm[i];  // NaN (unmatched) is neither
+    hot[i] = static_cast<int8_t>(d > threshold ? 1 : d < -threshold ? -1 : 0);
+  }
+  const std::vector<uint8_t> may =
+      nb.MayExceed(hot, static_cast<uint32_t>((min_neighbours + 1) / 2));
   std::vector<float> m(em.deviation_mm.size(), NAN);
   tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
   arena.execute([&] {
@@ -220,6 +295,7 @@ std::vector<float> RobustDeviation(const ErrorMapResult& em, const Neighbourhood
       std::vector<double> values;
       for (std::size_t k = range.begin(); k != range.end(); ++k) {
         const uint32_t i = order[k];
+        if (!may[i]) continue;
         nb.Local(i, near);
         if (near.size() < static_cast<std::size_t>(min_neighbours)) continue;
         values.clear();
@@ -480,7 +556,8 @@ absl::StatusOr<DefectsResult> FindDefects(const ErrorMapResult& em, const PointC
     nb = std::move(cells);
   }
   const std::vector<float> median =
-      RobustDeviation(em, *nb, order, settings.min_neighbours, settings.threads);
+      RobustDeviation(em, *nb, order, static_cast<float>(rules.threshold_mm),
+                      settings.min_neighbours, settings.threads);
   std::vector<int8_t> sign(median.size(), 0);
   std::vector<uint32_t> candidates;
   const float thr = static_cast<float>(rules.threshold_mm);
