@@ -5,19 +5,19 @@
 //
 // The steps, each from a standard source:
 //  1. Neighbourhoods on the surface: the measured points within a radius r
-//     (2.5 sampling spacings) in 3D. Organized cloud: searched in a pixel
-//     window around the point, 8-neighbours for linking. Unorganized (e.g.
-//     merged views): a uniform cell grid, cells r wide, searched 3 x 3 x 3
-//     (the fixed-radius near-neighbour grid, Bentley & Friedman, "Data
-//     structures for range searching", Computing Surveys 1979). A window
-//     never straddles a depth jump, and a mixed pixel hanging between two
-//     surfaces (kept by the filter through a chain of links) has too few
-//     neighbours for an estimate, so a band of them is never a defect.
+//     (2.5 sampling spacings) in 3D, searched in a pixel window on an
+//     organized grid and in a cell grid otherwise (merged views); see
+//     core/errormap/surface_neighbourhood.h. A window never straddles a
+//     depth jump, and a mixed pixel hanging between two surfaces (kept by
+//     the filter through a chain of links) has too few neighbours for an
+//     estimate, so a band of them is never a defect.
 //  2. A robust local estimate: the median of the signed deviations in each
 //     point's neighbourhood (Tukey's running median, "Exploratory Data
 //     Analysis", 1977). Sensor noise of sigma shrinks to ~1.25 sigma/sqrt(n)
 //     (n ~ 20: 0.004 mm at sigma 0.015 mm), and a stray point or a blob
-//     smaller than half a neighbourhood cannot move it.
+//     smaller than half a neighbourhood cannot move it. It is computed only
+//     where a window (or 27-cell) count of same-sign points beyond the
+//     threshold allows the median to pass it, which changes no result.
 //  3. Threshold |median| > threshold_mm, split by sign (dent below, bump
 //     above), and link same-sign candidates closer than the link distance
 //     into components with union-find (Tarjan, JACM 1975).
@@ -27,7 +27,7 @@
 //     components of at least min_area_mm2 are defects.
 //  5. The peak: an isotropic Gaussian c + A exp(-|x - x0|^2 / (2 s^2)) on
 //     the tangent plane at the deepest median, fitted by Levenberg-Marquardt
-//     (Marquardt, SIAM J. Appl. Math. 1963) to the raw deviations of the
+//     (core/errormap/gaussian_fit.h) to the raw deviations of the
 //     component and a ring around it (points beyond 5 robust sigma dropped
 //     and the fit repeated once); peak = c + A, the deviation at the fitted
 //     centre. Should the fit fail, the peak is the deepest median.
