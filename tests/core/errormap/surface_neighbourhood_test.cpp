@@ -56,7 +56,9 @@ void ExpectMayExceedIsASuperset(const SurfaceNeighbourhood& nb, const ErrorMapRe
     flagged += may[i];
   }
   EXPECT_GT(required, 0u);
-  if (expect_skips) EXPECT_LT(flagged, nb.MatchedOrder().size()) << "the screen skips points";
+  if (expect_skips) {
+    EXPECT_LT(flagged, nb.MatchedOrder().size()) << "the screen skips points";
+  }
 }
 
 TEST(SurfaceNeighbourhood, CellGridEqualsBruteForce) {
