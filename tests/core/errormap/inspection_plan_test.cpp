@@ -1,3 +1,5 @@
+// Tests core/errormap/inspection_plan.cpp (validation, resolution) and
+// core/errormap/inspection_plan_json.cpp (the JSON form).
 #include "core/errormap/inspection_plan.h"
 
 #include <gtest/gtest.h>
