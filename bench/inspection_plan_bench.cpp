@@ -1,0 +1,117 @@
+// The cost of an inspection plan next to the error map it judges: a ~2 M-point
+// organized scan of the demo pillar (2048 x 1536 sensor, noise 0.015 mm,
+// two planted dents), its error map, then a plan of 20 regions and 50
+// comparison points (resolution and the one-pass characteristics), and
+// defect detection on the same map. Goal: the characteristics add at most
+// 15% to the error map. Each step is timed best of 3, 2 threads.
+//
+//   build/bin/inspection_plan_bench
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <functional>
+
+#include "core/errormap/characteristics.h"
+#include "core/errormap/defects.h"
+#include "core/simulation/demo_cell.h"
+#include "core/types/transform.h"
+
+namespace {
+
+using namespace surfinspect;
+
+double BestOf3(const std::function<void()>& f) {
+  double best = 1e30;
+  for (int k = 0; k < 3; ++k) {
+    const auto t0 = std::chrono::steady_clock::now();
+    f();
+    best = std::min(best,
+                    std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+  return best;
+}
+
+InspectionPlan TwentyRegionsFiftyPoints() {
+  InspectionPlan plan;
+  plan.tolerance = {-0.1, 0.1};
+  for (int k = 0; k < 20; ++k) {  // 15 mm slices along x, each 30 mm long: every triangle in two
+    PlanRegion r;
+    r.name = "slice" + std::to_string(k);
+    r.select.box_min_mm = {-150 + 15.0 * k - 15, -80, -10};
+    r.select.box_max_mm = {-150 + 15.0 * k + 15, 80, 80};
+    r.tolerance = ToleranceBand{-0.05, 0.15};
+    plan.regions.push_back(r);
+  }
+  for (int k = 0; k < 50; ++k) {
+    const double x = -120 + 240.0 * k / 49;
+    ComparisonPoint p;
+    p.name = "P" + std::to_string(k);
+    p.position_mm = {x, (k % 5 - 2) * 8.0, 60.0 - 3.0 * (x / 150) * (x / 150)};
+    p.radius_mm = 2.0;
+    plan.points.push_back(p);
+  }
+  return plan;
+}
+
+int Run() {
+  const DemoCell cell = MakeDemoCell();
+  SensorIntrinsics in = cell.intrinsics;
+  in.width = 2048;
+  in.height = 1536;
+  ScanOptions opt;
+  opt.noise_sigma_mm = 0.015;
+  opt.defects = {{{-40, 5, 59.8}, 5, 0.2}, {{50, -8, 59.7}, 4, -0.1}};
+  const DemoViewpoint& vp = cell.viewpoints[2];
+  auto scan = SimulateScan(cell.part, cell.world_from_part, vp.world_from_sensor, in, opt);
+  if (!scan.ok()) return std::fprintf(stderr, "%s\n", scan.status().ToString().c_str()), 1;
+  const PointCloud cloud = TransformCloud(scan->cloud_in_sensor, vp.world_from_sensor);
+  auto index = MeshIndex::Build(cell.part);
+  if (!index.ok()) return 1;
+  ErrorMapSettings es;
+  es.threads = 2;
+  absl::StatusOr<ErrorMapResult> em;
+  const double t_map =
+      BestOf3([&] { em = ComputeErrorMap(**index, cloud, cell.world_from_part, es); });
+  if (!em.ok()) return 1;
+  const double matched = static_cast<double>(em->stats.matched);
+
+  const InspectionPlan plan = TwentyRegionsFiftyPoints();
+  absl::StatusOr<ResolvedInspectionPlan> rp;
+  const double t_resolve = BestOf3([&] { rp = ResolveInspectionPlan(plan, cell.part); });
+  if (!rp.ok()) return 1;
+  CharacteristicsSettings cs;
+  cs.threads = 2;
+  absl::StatusOr<CharacteristicsResult> ch;
+  const double t_char = BestOf3([&] { ch = ComputeCharacteristics(*em, *rp, 0, cs); });
+  if (!ch.ok()) return 1;
+  DefectRules rules;
+  rules.threshold_mm = 0.03;
+  DefectSettings ds;
+  ds.threads = 2;
+  absl::StatusOr<DefectsResult> defects;
+  const double t_defects =
+      BestOf3([&] { defects = FindDefects(*em, cloud, cell.part, rules, &*rp, ds); });
+  if (!defects.ok()) return 1;
+
+  std::printf("%zu points, %.0f matched, %zu triangles\n", cloud.size(), matched,
+              cell.part.num_triangles());
+  std::printf("error map          %8.1f ms  %6.1f ns/matched point\n", 1e3 * t_map,
+              1e9 * t_map / matched);
+  std::printf("plan resolution    %8.2f ms  (once per plan and mesh)\n", 1e3 * t_resolve);
+  std::printf("characteristics    %8.1f ms  %6.1f ns/matched point  %5.1f%% of the error map\n",
+              1e3 * t_char, 1e9 * t_char / matched, 100 * t_char / t_map);
+  std::printf("  (resolution included: %.1f%%)\n", 100 * (t_char + t_resolve) / t_map);
+  std::printf(
+      "defect detection   %8.1f ms  %6.1f ns/matched point  %5.1f%% of the error map,"
+      " %zu defects\n",
+      1e3 * t_defects, 1e9 * t_defects / matched, 100 * t_defects / t_map, defects->defects.size());
+  for (const Defect& d : defects->defects)
+    std::printf("  defect %d %s at (%.2f, %.2f, %.2f) peak %.4f mm area %.1f mm2\n", d.id,
+                DefectKindName(d.kind), d.centroid_mm.x(), d.centroid_mm.y(), d.centroid_mm.z(),
+                d.peak_mm, d.area_mm2);
+  return 0;
+}
+
+}  // namespace
+
+int main() { return Run(); }
