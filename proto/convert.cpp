@@ -123,6 +123,10 @@ absl::StatusOr<TriangleMesh> MeshFromProto(const v1::InlineMesh& msg, const std:
   if (nt > limits.max_triangles)
     return absl::ResourceExhaustedError(absl::StrCat(
         field, ": ", nt, " triangles exceed the server limit of ", limits.max_triangles));
+  // Checked before the copies: memcpy from an empty string's buffer into an
+  // empty vector's null data() is undefined even for 0 bytes.
+  if (msg.vertices().empty() || msg.triangles().empty())
+    return Invalid(field, "a mesh needs vertices and triangles");
   TriangleMesh m;
   m.vertices.resize(msg.vertices().size() / 12);
   m.triangles.resize(nt);

@@ -1,6 +1,9 @@
 #include "client/cell/cell_config.h"
 
+#include <cmath>
 #include <filesystem>
+#include <limits>
+#include <type_traits>
 
 #include "absl/strings/str_cat.h"
 #include "core/io/atomic_file.h"
@@ -47,6 +50,66 @@ absl::StatusOr<CellViewpoint> ReadViewpoint(const std::string& path, const nlohm
   return vp;
 }
 
+// obj[key] as a T, or `fallback` when absent. A number of the wrong kind or
+// out of T's range is refused by name: nlohmann's value<T>() would wrap -5
+// into an unsigned field and convert 1e300 into an int with undefined
+// behaviour.
+template <typename T>
+absl::StatusOr<T> Number(const nlohmann::json& obj, const char* key, T fallback,
+                         const std::string& where) {
+  if (!obj.contains(key)) return fallback;
+  const nlohmann::json& v = obj[key];
+  const std::string field = absl::StrCat(where, ".", key);
+  if constexpr (std::is_floating_point_v<T>) {
+    if (!v.is_number() || !std::isfinite(v.get<double>()))
+      return absl::InvalidArgumentError(absl::StrCat(field, " must be a finite number"));
+    return v.get<T>();
+  } else {
+    const bool in_range =
+        (v.is_number_unsigned() && v.get<uint64_t>() <= uint64_t(std::numeric_limits<T>::max())) ||
+        (v.is_number_integer() && !v.is_number_unsigned() &&
+         v.get<int64_t>() >= int64_t(std::numeric_limits<T>::min()) &&
+         v.get<int64_t>() <= int64_t(std::numeric_limits<T>::max()));
+    if (!in_range)
+      return absl::InvalidArgumentError(absl::StrCat(field, " must be a whole number in [",
+                                                     std::numeric_limits<T>::min(), ", ",
+                                                     std::numeric_limits<T>::max(), "]"));
+    return v.get<T>();
+  }
+}
+
+// Reads the optional tolerance_mm, error_map{...} and filter{...} blocks.
+absl::Status ReadSettings(const nlohmann::json& j, CellConfig& c) {
+  ErrorMapSettings& e = c.error_map;
+  LinkClusteringSettings& f = c.filter_settings;
+  absl::Status st;
+  auto take = [&st](auto value, auto& into) {
+    if (!value.ok()) {
+      if (st.ok()) st = value.status();
+      return;
+    }
+    into = *value;
+  };
+  take(Number(j, "tolerance_mm", e.tolerance_mm, "cell"), e.tolerance_mm);
+  if (j.contains("error_map")) {
+    const auto& m = j["error_map"];
+    if (!m.is_object()) return absl::InvalidArgumentError("error_map must be an object");
+    take(Number(m, "max_distance_mm", e.max_distance_mm, "error_map"), e.max_distance_mm);
+    take(Number(m, "allowed_fraction_outside", e.allowed_fraction_outside, "error_map"),
+         e.allowed_fraction_outside);
+    take(Number(m, "histogram_bins", e.histogram_bins, "error_map"), e.histogram_bins);
+  }
+  if (j.contains("filter")) {
+    const auto& m = j["filter"];
+    if (!m.is_object()) return absl::InvalidArgumentError("filter must be an object");
+    c.filter = m.value("enabled", true);
+    take(Number(m, "link_distance_mm", f.link_distance_mm, "filter"), f.link_distance_mm);
+    take(Number(m, "min_cluster_points", f.min_cluster_points, "filter"), f.min_cluster_points);
+    take(Number(m, "connectivity", f.connectivity, "filter"), f.connectivity);
+  }
+  return st;
+}
+
 }  // namespace
 
 absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
@@ -75,23 +138,7 @@ absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
       if (!vp.ok()) return vp.status();
       c.viewpoints.push_back(*std::move(vp));
     }
-    if (j.contains("tolerance_mm")) c.error_map.tolerance_mm = j["tolerance_mm"].get<double>();
-    if (j.contains("error_map")) {
-      const auto& e = j["error_map"];
-      c.error_map.max_distance_mm = e.value("max_distance_mm", c.error_map.max_distance_mm);
-      c.error_map.allowed_fraction_outside =
-          e.value("allowed_fraction_outside", c.error_map.allowed_fraction_outside);
-      c.error_map.histogram_bins = e.value("histogram_bins", c.error_map.histogram_bins);
-    }
-    if (j.contains("filter")) {
-      const auto& f = j["filter"];
-      c.filter = f.value("enabled", true);
-      c.filter_settings.link_distance_mm =
-          f.value("link_distance_mm", c.filter_settings.link_distance_mm);
-      c.filter_settings.min_cluster_points =
-          f.value("min_cluster_points", c.filter_settings.min_cluster_points);
-      c.filter_settings.connectivity = f.value("connectivity", c.filter_settings.connectivity);
-    }
+    if (auto st = ReadSettings(j, c); !st.ok()) return Bad(path, st.message());
     if (j.contains("server")) {
       const auto& s = j["server"];
       c.server.target = s.value("target", "");

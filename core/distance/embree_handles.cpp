@@ -9,9 +9,16 @@ namespace surfinspect {
 absl::StatusOr<std::shared_ptr<EmbreeDevice>> EmbreeDevice::Create(const std::string& config) {
   std::shared_ptr<EmbreeDevice> d(new EmbreeDevice());
   d->device_ = rtcNewDevice(config.empty() ? nullptr : config.c_str());
-  if (!d->device_)
-    return absl::InternalError(absl::StrCat("embree: cannot create device (error ",
-                                            static_cast<int>(rtcGetDeviceError(nullptr)), ")"));
+  if (!d->device_) {
+    // Only a bad configuration string is our mistake. Otherwise the device
+    // failed for want of memory or threads (it starts its own thread pool),
+    // which a caller retries later: RESOURCE_EXHAUSTED, not INTERNAL.
+    const RTCError code = rtcGetDeviceError(nullptr);
+    const std::string text = absl::StrCat("embree: cannot create device (error ", int(code), ")");
+    return code == RTC_ERROR_INVALID_ARGUMENT || code == RTC_ERROR_INVALID_OPERATION
+               ? absl::InternalError(text)
+               : absl::ResourceExhaustedError(text);
+  }
   rtcSetDeviceErrorFunction(d->device_, &EmbreeDevice::OnError, d.get());
   return d;
 }

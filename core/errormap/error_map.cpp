@@ -100,14 +100,15 @@ void ComputeStats(const ErrorMapSettings& settings, ErrorMapResult& r) {
   h.max_mm = range;
   h.counts.assign(static_cast<std::size_t>(settings.histogram_bins), 0);
   const double per_mm = settings.histogram_bins / (2 * range);
+  const double last_bin = double(h.counts.size() - 1);
   for (float d : r.deviation_mm) {
     if (std::isnan(d)) continue;
     if (d < -range)
       ++h.below_range;
     else if (d >= range)
       ++h.above_range;
-    else
-      ++h.counts[std::min(h.counts.size() - 1, static_cast<std::size_t>((d + range) * per_mm))];
+    else  // clamped in double first: a float-to-integer conversion out of range is undefined
+      ++h.counts[static_cast<std::size_t>(std::min(last_bin, (d + range) * per_mm))];
   }
 }
 
@@ -117,8 +118,8 @@ absl::Status ValidateErrorMapSettings(const ErrorMapSettings& s) {
   auto bad = [](absl::string_view what, double v) {
     return absl::InvalidArgumentError(absl::StrCat("error map: ", what, ", got ", v));
   };
-  if (!(s.tolerance_mm > 0) || !std::isfinite(s.tolerance_mm))
-    return bad("tolerance_mm must be a positive number", s.tolerance_mm);
+  if (!(s.tolerance_mm >= kMinLengthMm) || !std::isfinite(s.tolerance_mm))
+    return bad(absl::StrCat("tolerance_mm must be a number >= ", kMinLengthMm), s.tolerance_mm);
   if (!(s.max_distance_mm > 0))
     return bad("max_distance_mm must be > 0 (inf allowed)", s.max_distance_mm);
   if (!(s.allowed_fraction_outside >= 0 && s.allowed_fraction_outside <= 1))
@@ -126,8 +127,10 @@ absl::Status ValidateErrorMapSettings(const ErrorMapSettings& s) {
   if (s.histogram_bins < 1 || s.histogram_bins > kMaxHistogramBins)
     return bad(absl::StrCat("histogram_bins must be in [1, ", kMaxHistogramBins, "]"),
                s.histogram_bins);
-  if (!(s.histogram_range_mm >= 0) || !std::isfinite(s.histogram_range_mm))
-    return bad("histogram_range_mm must be >= 0 (0 = auto)", s.histogram_range_mm);
+  if (!(s.histogram_range_mm == 0 || s.histogram_range_mm >= kMinLengthMm) ||
+      !std::isfinite(s.histogram_range_mm))
+    return bad(absl::StrCat("histogram_range_mm must be 0 (auto) or >= ", kMinLengthMm),
+               s.histogram_range_mm);
   if (s.threads < 0 || s.threads > kMaxQueryThreads)
     return bad(absl::StrCat("threads must be in [0, ", kMaxQueryThreads, "]"), s.threads);
   return absl::OkStatus();

@@ -26,6 +26,9 @@ namespace surfinspect {
 
 // 100000 bins are 0.8 MB of counts, far below a reply's size limit.
 constexpr int kMaxHistogramBins = 100000;
+// The smallest tolerance and histogram half-width, mm (1 pm: far below any
+// sensor's noise). Smaller ones would only make the bin width overflow.
+constexpr double kMinLengthMm = 1e-9;
 
 struct ErrorMapSettings {
   double tolerance_mm = 0.1;     // the +-tol band; > 0

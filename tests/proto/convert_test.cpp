@@ -200,3 +200,24 @@ TEST(StageToProto, EveryCoreStageHasItsWireStage) {
 
 }  // namespace
 }  // namespace surfinspect::wire
+
+namespace surfinspect::wire {
+namespace {
+
+TEST(MeshFromProto, AnEmptyMeshIsRefusedBeforeAnyCopy) {
+  v1::InlineMesh msg;
+  Limits limits;
+  EXPECT_EQ(MeshFromProto(msg, "part.inline", limits).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  msg.mutable_vertices()->assign(36, '\0');  // three vertices, no triangle
+  auto m = MeshFromProto(msg, "part.inline", limits);
+  ASSERT_EQ(m.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(m.status().message().find("part.inline"), std::string::npos) << m.status();
+  msg.clear_vertices();
+  msg.mutable_triangles()->assign(12, '\0');  // a triangle, no vertices
+  EXPECT_EQ(MeshFromProto(msg, "part.inline", limits).status().code(),
+            absl::StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace surfinspect::wire

@@ -1,8 +1,12 @@
 #include "core/distance/embree_handles.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <fstream>
 
 #include "absl/strings/str_cat.h"
 #include "tests/support/test_meshes.h"
@@ -164,6 +168,35 @@ TEST(EmbreeHandles, BuildRejectsAnInvalidMeshBeforeEmbreeSeesIt) {
   EXPECT_EQ(EmbreeTriangleScene::Build(*device, TriangleMesh{}).status().code(),
             absl::StatusCode::kInvalidArgument);
   EXPECT_TRUE((*device)->TakeError().ok());
+}
+
+}  // namespace
+}  // namespace surfinspect
+
+namespace surfinspect {
+namespace {
+
+// A device that cannot get the memory for its thread pool is a retryable
+// RESOURCE_EXHAUSTED, not INTERNAL. Tried in a child process whose address
+// space is capped a little above what it already maps.
+TEST(EmbreeDeviceCreate, OutOfAddressSpaceIsResourceExhausted) {
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    std::ifstream statm("/proc/self/statm");
+    uint64_t pages = 0;
+    statm >> pages;
+    const rlim_t cap = pages * uint64_t(sysconf(_SC_PAGESIZE)) + (uint64_t{8} << 20);
+    rlimit limit{cap, cap};
+    setrlimit(RLIMIT_AS, &limit);
+    auto device = EmbreeDevice::Create("threads=8");
+    _exit(device.ok() ? 100 : static_cast<int>(device.status().code()));
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status));
+  if (WEXITSTATUS(status) == 100) GTEST_SKIP() << "the device was created within the cap";
+  EXPECT_EQ(WEXITSTATUS(status), static_cast<int>(absl::StatusCode::kResourceExhausted));
 }
 
 }  // namespace

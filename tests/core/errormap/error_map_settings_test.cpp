@@ -42,6 +42,9 @@ TEST(ErrorMapSettings, EachFieldAtItsEdges) {
   auto range = [](ErrorMapSettings& s, double v) { s.histogram_range_mm = v; };
   ExpectEdge("histogram_range_mm", range, 0, -1e-12);
   ExpectEdge("histogram_range_mm", range, 1e300, INFINITY);
+  // Denormal lengths would overflow the bin width (bins / 2 range).
+  ExpectEdge("histogram_range_mm", range, kMinLengthMm, 1e-310);
+  ExpectEdge("tolerance_mm", tol, kMinLengthMm, 1e-310);
   auto threads = [](ErrorMapSettings& s, double v) { s.threads = static_cast<int>(v); };
   ExpectEdge("threads", threads, 0, -1);
   ExpectEdge("threads", threads, kMaxQueryThreads, kMaxQueryThreads + 1);

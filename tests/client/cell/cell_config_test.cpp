@@ -1,0 +1,75 @@
+// ReadCellConfig (client/cell/cell_config.cpp): the settings blocks of
+// cell.json, and numbers that must not wrap or overflow on their way into
+// fixed-width fields.
+#include "client/cell/cell_config.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "tests/support/temp_dir.h"
+
+namespace surfinspect::client {
+namespace {
+
+const char* kIdentity = R"({"matrix": [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]})";
+
+std::string Cell(const std::string& extra) {
+  return std::string(R"({"part": {"mesh": "part.stl", "world_from_part": )") + kIdentity +
+         R"(}, "viewpoints": [{"name": "v1"}])" + extra + "}";
+}
+
+absl::StatusOr<CellConfig> Read(const std::string& text) {
+  static testing::TempDir dir;
+  const std::string path = dir.File("cell.json");
+  testing::WriteBytes(path, text);
+  return ReadCellConfig(path);
+}
+
+TEST(CellConfig, ReadsTheSettingsBlocks) {
+  auto c = Read(Cell(R"(, "tolerance_mm": 0.2,
+      "error_map": {"max_distance_mm": 4, "allowed_fraction_outside": 0.01, "histogram_bins": 31},
+      "filter": {"enabled": false, "link_distance_mm": 0.7, "min_cluster_points": 20,
+                 "connectivity": 4})"));
+  ASSERT_TRUE(c.ok()) << c.status();
+  EXPECT_DOUBLE_EQ(c->error_map.tolerance_mm, 0.2);
+  EXPECT_DOUBLE_EQ(c->error_map.max_distance_mm, 4);
+  EXPECT_DOUBLE_EQ(c->error_map.allowed_fraction_outside, 0.01);
+  EXPECT_EQ(c->error_map.histogram_bins, 31);
+  EXPECT_FALSE(c->filter);
+  EXPECT_FLOAT_EQ(c->filter_settings.link_distance_mm, 0.7f);
+  EXPECT_EQ(c->filter_settings.min_cluster_points, 20u);
+  EXPECT_EQ(c->filter_settings.connectivity, 4);
+}
+
+TEST(CellConfig, RefusesNumbersThatWouldWrapOrOverflowByName) {
+  const std::pair<std::string, std::string> cases[] = {
+      {R"(, "filter": {"min_cluster_points": -5})", "filter.min_cluster_points"},
+      {R"(, "filter": {"min_cluster_points": 1e300})", "filter.min_cluster_points"},
+      {R"(, "filter": {"connectivity": 1e300})", "filter.connectivity"},
+      {R"(, "filter": {"connectivity": 4.5})", "filter.connectivity"},
+      {R"(, "filter": {"link_distance_mm": "x"})", "filter.link_distance_mm"},
+      {R"(, "error_map": {"histogram_bins": 1e300})", "error_map.histogram_bins"},
+      {R"(, "error_map": {"histogram_bins": 4294967337})", "error_map.histogram_bins"},
+      {R"(, "error_map": {"max_distance_mm": null})", "error_map.max_distance_mm"},
+      {R"(, "tolerance_mm": "0.1")", "cell.tolerance_mm"},
+      {R"(, "error_map": [1, 2])", "error_map must be an object"},
+  };
+  for (const auto& [extra, field] : cases) {
+    auto c = Read(Cell(extra));
+    ASSERT_FALSE(c.ok()) << extra;
+    EXPECT_EQ(c.status().code(), absl::StatusCode::kInvalidArgument) << extra;
+    EXPECT_NE(c.status().message().find(field), std::string::npos) << extra << ": " << c.status();
+  }
+}
+
+TEST(CellConfig, ValuesInRangeStillMeetTheOneValidator) {
+  // A whole number in range reaches ValidateLinkClusteringSettings, which
+  // knows connectivity is 4 or 8.
+  auto c = Read(Cell(R"(, "filter": {"connectivity": 6})"));
+  ASSERT_FALSE(c.ok());
+  EXPECT_NE(c.status().message().find("connectivity"), std::string::npos) << c.status();
+}
+
+}  // namespace
+}  // namespace surfinspect::client
