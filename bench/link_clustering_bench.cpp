@@ -24,6 +24,7 @@
 #include <map>
 #include <random>
 
+#include "bench/clustering_inputs.h"
 #include "core/filter/link_clustering.h"
 #include "core/filter/link_clustering_grid.h"
 #include "core/filter/link_clustering_unorganized.h"
@@ -33,43 +34,11 @@
 namespace {
 
 using namespace surfinspect;
+using bench::DemoScan;
+using bench::Shuffled;
+using bench::ToPcl;
 
 const LinkClusteringSettings kSettings;  // the defaults: 0.5 mm, 50 points, 8 neighbours
-
-PointCloud DemoScan(uint32_t width, uint32_t height) {
-  const DemoCell cell = MakeDemoCell();
-  SensorIntrinsics in = cell.intrinsics;
-  in.width = width;
-  in.height = height;
-  ScanOptions opt;
-  opt.noise_sigma_mm = 0.015;
-  opt.pulse_fraction = 0.003;
-  opt.stripes = true;
-  const DemoViewpoint& vp = cell.viewpoints[2];
-  auto scan = SimulateScan(cell.part, cell.world_from_part, vp.world_from_sensor, in, opt);
-  if (!scan.ok()) std::abort();
-  return std::move(scan->cloud_in_sensor);
-}
-
-// Valid points in a fixed random order (an unorganized cloud has no order).
-PointCloud Shuffled(const PointCloud& c, std::size_t max_points) {
-  std::vector<Eigen::Vector3f> pts;
-  c.ForEachValid([&](std::size_t, const Eigen::Vector3f& p) { pts.push_back(p); });
-  std::shuffle(pts.begin(), pts.end(), std::mt19937(1));
-  if (pts.size() > max_points) pts.resize(max_points);
-  return PointCloud::Unorganized(std::move(pts));
-}
-
-pcl::PointCloud<pcl::PointXYZ>::Ptr ToPcl(const PointCloud& c) {
-  auto out = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
-  out->resize(c.size());
-  out->width = c.width;
-  out->height = c.height;
-  out->is_dense = false;
-  for (std::size_t i = 0; i < c.size(); ++i)
-    (*out)[i] = pcl::PointXYZ(c.points[i].x(), c.points[i].y(), c.points[i].z());
-  return out;
-}
 
 struct Data {
   PointCloud scan = DemoScan(1024, 768);

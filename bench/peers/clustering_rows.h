@@ -21,6 +21,7 @@
 #include <map>
 #include <random>
 
+#include "bench/clustering_inputs.h"
 #include "bench/peers/report.h"
 #include "core/filter/link_clustering.h"
 #include "core/filter/link_clustering_grid.h"
@@ -31,40 +32,6 @@
 namespace surfinspect::bench {
 
 namespace clustering_detail {
-
-inline PointCloud DemoScan(uint32_t width, uint32_t height) {
-  const DemoCell cell = MakeDemoCell();
-  SensorIntrinsics in = cell.intrinsics;
-  in.width = width;
-  in.height = height;
-  ScanOptions opt;
-  opt.noise_sigma_mm = 0.015;
-  opt.pulse_fraction = 0.003;
-  opt.stripes = true;
-  auto scan =
-      SimulateScan(cell.part, cell.world_from_part, cell.viewpoints[2].world_from_sensor, in, opt);
-  if (!scan.ok()) return {};
-  return std::move(scan->cloud_in_sensor);
-}
-
-inline PointCloud Shuffled(const PointCloud& c, std::size_t max_points) {
-  std::vector<Eigen::Vector3f> pts;
-  c.ForEachValid([&](std::size_t, const Eigen::Vector3f& p) { pts.push_back(p); });
-  std::shuffle(pts.begin(), pts.end(), std::mt19937(1));
-  if (pts.size() > max_points) pts.resize(max_points);
-  return PointCloud::Unorganized(std::move(pts));
-}
-
-inline pcl::PointCloud<pcl::PointXYZ>::Ptr ToPcl(const PointCloud& c) {
-  auto out = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
-  out->resize(c.size());
-  out->width = c.width;
-  out->height = c.height;
-  out->is_dense = false;
-  for (std::size_t i = 0; i < c.size(); ++i)
-    (*out)[i] = pcl::PointXYZ(c.points[i].x(), c.points[i].y(), c.points[i].z());
-  return out;
-}
 
 // Points (among those labelled in `ours`) whose component pairing with the
 // peer's is not one-to-one: 0 means the same partition up to renaming.

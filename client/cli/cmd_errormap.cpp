@@ -39,72 +39,62 @@ double Number(const nlohmann::json& j, const char* key) {
   return j.contains(key) && j[key].is_number() ? j[key].get<double>() : NAN;
 }
 
-void RunErrorMap(const ErrorMapArgs& a) {
-  auto t0 = std::chrono::steady_clock::now();
-  const PointCloud cloud_in_world = Take(ReadPointCloud(a.cloud));
-  const Eigen::Isometry3d world_from_part = a.world_from_part.empty()
-                                                ? Eigen::Isometry3d::Identity()
-                                                : Take(ReadTransformJson(a.world_from_part));
-  auto mesh = Take(ReadMesh(a.mesh));
-  spdlog::info("read {} points and {} triangles in {:.3f} s", cloud_in_world.size(),
-               mesh.num_triangles(), Seconds(t0));
-  const MeshTopology topo = AnalyzeTopology(mesh);
-  const nlohmann::json mesh_json = {{"triangles", mesh.num_triangles()},
-                                    {"boundary_edges", topo.boundary_edges},
-                                    {"nonmanifold_edges", topo.nonmanifold_edges},
-                                    {"degenerate_triangles", mesh.CountDegenerate()}};
-  const PointCloud cloud_in_part = TransformCloud(cloud_in_world, world_from_part.inverse());
-  ErrorMapResult r;
-  nlohmann::json j;
+// What either path computed: the per-point result, the report JSON and the
+// PNG bytes.
+struct ErrorMapRun {
+  ErrorMapResult result;
+  nlohmann::json report;
   std::string png_bytes;
-  if (a.remote.remote()) {
-    // The server computes; PLY/CSV are written here from its deviations, the
-    // report and PNG are its bytes (so both paths write the same files,
-    // timing aside).
-    if (a.settings.split_components) throw CommandFailed("--split-components is in-process only");
-    if (!a.png.empty() && a.png_axis != "auto")
-      throw CommandFailed("--png-axis is in-process only");
-    v1::ErrorMapRequest req;
-    wire::CloudToProto(cloud_in_world, req.mutable_cloud());
-    wire::TransformToProto(world_from_part, req.mutable_world_from_part());
-    wire::ErrorMapSettingsToProto(a.settings, req.mutable_settings());
-    req.set_return_deviations(true);
-    req.set_return_png(!a.png.empty());
-    const v1::ErrorMapResponse resp = Take(Connect(a.remote)->ErrorMap(req, mesh));
-    r.deviation_mm = wire::UnpackFloats(resp.deviations());
-    if (r.deviation_mm.size() != cloud_in_world.size())
-      throw CommandFailed("server sent a wrong deviation count");
-    j = nlohmann::json::parse(resp.report_json(), nullptr, false);
-    if (j.is_discarded()) throw CommandFailed("server sent a malformed report");
-    r.tolerance_mm = Number(j["tolerance"], "band_mm");
-    r.color_range_mm = Number(j, "color_range_mm");
-    png_bytes = resp.png();
-  } else {
-    const std::unique_ptr<MeshIndex> index = Take(MeshIndex::Build(std::move(mesh)));
-    spdlog::info("mesh index built in {:.3f} s ({} boundary edges, {} degenerate triangles)",
-                 index->info().build_seconds, topo.boundary_edges,
-                 index->info().degenerate_triangles);
-    r = Take(ComputeErrorMap(*index, cloud_in_world, world_from_part, a.settings));
-    spdlog::info("distances for {} points in {:.3f} s", r.stats.count, r.query_seconds);
-    j = ErrorMapReportJson(r, a.settings);
-    if (!a.png.empty()) {
-      ErrorMapPngOptions png;
-      png.view_axis = a.png_axis == "x" ? 0 : a.png_axis == "y" ? 1 : a.png_axis == "z" ? 2 : -1;
-      png_bytes = Take(
-          EncodePng(Take(RenderErrorMap(cloud_in_part, r, ComputeBounds(index->mesh()), png))));
-    }
+};
+
+// The server computes; PLY/CSV are written here from its deviations, the
+// report and PNG are its bytes (so both paths write the same files, timing
+// aside).
+ErrorMapRun RemoteErrorMap(const ErrorMapArgs& a, const PointCloud& cloud_in_world,
+                           const Eigen::Isometry3d& world_from_part, const TriangleMesh& mesh) {
+  if (a.settings.split_components) throw CommandFailed("--split-components is in-process only");
+  if (!a.png.empty() && a.png_axis != "auto") throw CommandFailed("--png-axis is in-process only");
+  v1::ErrorMapRequest req;
+  wire::CloudToProto(cloud_in_world, req.mutable_cloud());
+  wire::TransformToProto(world_from_part, req.mutable_world_from_part());
+  wire::ErrorMapSettingsToProto(a.settings, req.mutable_settings());
+  req.set_return_deviations(true);
+  req.set_return_png(!a.png.empty());
+  const v1::ErrorMapResponse resp = Take(Connect(a.remote)->ErrorMap(req, mesh));
+  ErrorMapRun run;
+  run.result.deviation_mm = wire::UnpackFloats(resp.deviations());
+  if (run.result.deviation_mm.size() != cloud_in_world.size())
+    throw CommandFailed("server sent a wrong deviation count");
+  run.report = nlohmann::json::parse(resp.report_json(), nullptr, false);
+  if (run.report.is_discarded()) throw CommandFailed("server sent a malformed report");
+  run.result.tolerance_mm = Number(run.report["tolerance"], "band_mm");
+  run.result.color_range_mm = Number(run.report, "color_range_mm");
+  run.png_bytes = resp.png();
+  return run;
+}
+
+ErrorMapRun LocalErrorMap(const ErrorMapArgs& a, const PointCloud& cloud_in_world,
+                          const PointCloud& cloud_in_part, const Eigen::Isometry3d& world_from_part,
+                          TriangleMesh mesh, const MeshTopology& topo) {
+  const std::unique_ptr<MeshIndex> index = Take(MeshIndex::Build(std::move(mesh)));
+  spdlog::info("mesh index built in {:.3f} s ({} boundary edges, {} degenerate triangles)",
+               index->info().build_seconds, topo.boundary_edges,
+               index->info().degenerate_triangles);
+  ErrorMapRun run;
+  run.result = Take(ComputeErrorMap(*index, cloud_in_world, world_from_part, a.settings));
+  spdlog::info("distances for {} points in {:.3f} s", run.result.stats.count,
+               run.result.query_seconds);
+  run.report = ErrorMapReportJson(run.result, a.settings);
+  if (!a.png.empty()) {
+    ErrorMapPngOptions png;
+    png.view_axis = a.png_axis == "x" ? 0 : a.png_axis == "y" ? 1 : a.png_axis == "z" ? 2 : -1;
+    run.png_bytes = Take(EncodePng(
+        Take(RenderErrorMap(cloud_in_part, run.result, ComputeBounds(index->mesh()), png))));
   }
-  // Files carry part-frame coordinates by default, so they overlay the CAD.
-  const PointCloud& written = a.frame == "world" ? cloud_in_world : cloud_in_part;
-  Check(WriteErrorMapPly(a.out, written, r, a.frame));
-  if (!a.csv.empty()) Check(WriteErrorMapCsv(a.csv, written, r));
-  if (!a.png.empty()) Check(WriteStringAtomically(a.png, png_bytes));
-  if (!a.report.empty()) {
-    j["inputs"] = {{"cloud", a.cloud}, {"mesh", a.mesh}, {"world_from_part", a.world_from_part}};
-    j["mesh"] = mesh_json;
-    j["output_frame"] = a.frame;
-    Check(WriteStringAtomically(a.report, j.dump(2) + "\n"));
-  }
+  return run;
+}
+
+void PrintSummary(const ErrorMapArgs& a, const nlohmann::json& j) {
   const nlohmann::json& st = j["statistics"];
   const nlohmann::json& pts = j["points"];
   std::printf("points: %zu (valid %zu, matched %zu within %g mm)\n",
@@ -120,6 +110,39 @@ void RunErrorMap(const ErrorMapArgs& a) {
   std::printf("wrote %s%s%s%s%s%s%s\n", a.out.c_str(), a.csv.empty() ? "" : ", ", a.csv.c_str(),
               a.report.empty() ? "" : ", ", a.report.c_str(), a.png.empty() ? "" : ", ",
               a.png.c_str());
+}
+
+void RunErrorMap(const ErrorMapArgs& a) {
+  auto t0 = std::chrono::steady_clock::now();
+  const PointCloud cloud_in_world = Take(ReadPointCloud(a.cloud));
+  const Eigen::Isometry3d world_from_part = a.world_from_part.empty()
+                                                ? Eigen::Isometry3d::Identity()
+                                                : Take(ReadTransformJson(a.world_from_part));
+  auto mesh = Take(ReadMesh(a.mesh));
+  spdlog::info("read {} points and {} triangles in {:.3f} s", cloud_in_world.size(),
+               mesh.num_triangles(), Seconds(t0));
+  const MeshTopology topo = AnalyzeTopology(mesh);
+  const nlohmann::json mesh_json = {{"triangles", mesh.num_triangles()},
+                                    {"boundary_edges", topo.boundary_edges},
+                                    {"nonmanifold_edges", topo.nonmanifold_edges},
+                                    {"degenerate_triangles", mesh.CountDegenerate()}};
+  const PointCloud cloud_in_part = TransformCloud(cloud_in_world, world_from_part.inverse());
+  ErrorMapRun run = a.remote.remote() ? RemoteErrorMap(a, cloud_in_world, world_from_part, mesh)
+                                      : LocalErrorMap(a, cloud_in_world, cloud_in_part,
+                                                      world_from_part, std::move(mesh), topo);
+  // Files carry part-frame coordinates by default, so they overlay the CAD.
+  const PointCloud& written = a.frame == "world" ? cloud_in_world : cloud_in_part;
+  Check(WriteErrorMapPly(a.out, written, run.result, a.frame));
+  if (!a.csv.empty()) Check(WriteErrorMapCsv(a.csv, written, run.result));
+  if (!a.png.empty()) Check(WriteStringAtomically(a.png, run.png_bytes));
+  if (!a.report.empty()) {
+    run.report["inputs"] = {
+        {"cloud", a.cloud}, {"mesh", a.mesh}, {"world_from_part", a.world_from_part}};
+    run.report["mesh"] = mesh_json;
+    run.report["output_frame"] = a.frame;
+    Check(WriteStringAtomically(a.report, run.report.dump(2) + "\n"));
+  }
+  PrintSummary(a, run.report);
 }
 
 }  // namespace

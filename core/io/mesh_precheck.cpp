@@ -154,18 +154,29 @@ bool CornerOk(std::string_view c, const ObjCounts& total, const ObjCounts& so_fa
   return IndexOk(rest.substr(s2 + 1), total.vn, so_far.vn);
 }
 
-ObjCounts CountObjEntries(std::string_view bytes) {
-  ObjCounts c;
+// Calls visit(tokens, line number) for every OBJ line with a token, comments
+// (from '#') cut; stops at the first error visit returns.
+template <typename Visit>
+absl::Status ForEachObjLine(std::string_view bytes, Visit&& visit) {
   LineScanner lines(bytes);
   std::string_view line;
   std::vector<std::string_view> tok;
   while (lines.Next(&line)) {
     SplitWhitespace(line.substr(0, line.find('#')), &tok);
     if (tok.empty()) continue;
+    if (absl::Status st = visit(tok, lines.line_number()); !st.ok()) return st;
+  }
+  return absl::OkStatus();
+}
+
+ObjCounts CountObjEntries(std::string_view bytes) {
+  ObjCounts c;
+  (void)ForEachObjLine(bytes, [&c](const std::vector<std::string_view>& tok, std::size_t) {
     c.v += tok[0] == "v";
     c.vt += tok[0] == "vt";
     c.vn += tok[0] == "vn";
-  }
+    return absl::OkStatus();
+  });
   return c;
 }
 
@@ -206,15 +217,13 @@ absl::Status CheckObj(std::string_view bytes, const MeshReadLimits& limits, std:
   const ObjCounts total = CountObjEntries(bytes);
   ObjCounts so_far;
   uint64_t faces = 0;
-  LineScanner lines(bytes);
-  std::string_view line;
-  std::vector<std::string_view> tok;
-  while (lines.Next(&line)) {
-    SplitWhitespace(line.substr(0, line.find('#')), &tok);
-    if (tok.empty()) continue;
-    if (auto st = CheckObjLine(tok, total, &so_far, lines.line_number(), name); !st.ok()) return st;
-    if (tok[0] == "f" && ++faces > limits.max_triangles) return TooMany(name, faces, limits);
-  }
+  absl::Status st = ForEachObjLine(
+      bytes, [&](const std::vector<std::string_view>& tok, std::size_t line) -> absl::Status {
+        if (auto bad = CheckObjLine(tok, total, &so_far, line, name); !bad.ok()) return bad;
+        if (tok[0] == "f" && ++faces > limits.max_triangles) return TooMany(name, faces, limits);
+        return absl::OkStatus();
+      });
+  if (!st.ok()) return st;
   if (total.v == 0) return Refuse(name, "OBJ holds no vertices");
   return absl::OkStatus();
 }

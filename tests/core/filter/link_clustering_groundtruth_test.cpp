@@ -156,7 +156,7 @@ std::vector<SimulatedScan>* LinkClusteringGroundTruth::scans_ = nullptr;
 
 // The targets for scans that feed an error map: >= 99% of pulses and 95% of
 // stripe pixels removed, >= 99% of good and 99.9% of dent points kept.
-TEST_F(LinkClusteringGroundTruth, InspectionPresetMeetsTheIssueTargets) {
+TEST_F(LinkClusteringGroundTruth, InspectionPresetMeetsItsTargets) {
   const Score total = FilterAll(LinkClusteringSettings::ForInspection());
   EXPECT_GE(total.pulse_recall(), 0.99) << total;
   EXPECT_GE(total.stripe_recall(), 0.95) << total;

@@ -1,26 +1,16 @@
 #include "core/io/png_image.h"
 
 #include <gtest/gtest.h>
-#include <png.h>
 
 #include <filesystem>
 #include <string>
 
+#include "tests/support/png_decode.h"
 #include "tests/support/temp_dir.h"
 
 namespace surfinspect {
 namespace {
 
-// Decodes PNG bytes with libpng's reader into 8-bit RGB; width 0 on failure.
-RgbImage Decode(const std::string& bytes) {
-  png_image img{};
-  img.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_memory(&img, bytes.data(), bytes.size())) return {};
-  img.format = PNG_FORMAT_RGB;
-  RgbImage out(img.width, img.height);
-  if (!png_image_finish_read(&img, nullptr, out.pixels.data(), 0, nullptr)) return {};
-  return out;
-}
 
 RgbImage Gradient(uint32_t w, uint32_t h) {
   RgbImage img(w, h);
@@ -43,7 +33,7 @@ TEST(PngImage, EncodedBytesDecodeToTheSamePixels) {
     auto bytes = EncodePng(img);
     ASSERT_TRUE(bytes.ok()) << bytes.status();
     EXPECT_EQ(bytes->substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
-    const RgbImage back = Decode(*bytes);
+    const RgbImage back = testing::DecodePng(*bytes);
     EXPECT_EQ(back.width, w);
     EXPECT_EQ(back.height, h);
     EXPECT_TRUE(back.pixels == img.pixels) << w << "x" << h;
@@ -56,7 +46,7 @@ TEST(PngImage, WritePngWritesTheSameBytesToAFile) {
   ASSERT_TRUE(WritePng(dir.File("map.png"), img).ok());
   const std::string file = testing::ReadBytes(dir.File("map.png"));
   EXPECT_EQ(file, *EncodePng(img));
-  const RgbImage back = Decode(file);
+  const RgbImage back = testing::DecodePng(file);
   EXPECT_EQ(back.width, 64u);
   EXPECT_EQ(back.height, 48u);
   EXPECT_TRUE(back.pixels == img.pixels);

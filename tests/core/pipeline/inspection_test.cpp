@@ -4,7 +4,6 @@
 #include "core/pipeline/inspection.h"
 
 #include <gtest/gtest.h>
-#include <png.h>
 
 #include <algorithm>
 #include <cmath>
@@ -13,6 +12,7 @@
 
 #include "core/errormap/error_map_output.h"
 #include "core/errormap/error_map_png.h"
+#include "tests/support/png_decode.h"
 #include "core/simulation/demo_cell.h"
 #include "core/simulation/scan_simulator.h"
 #include "core/types/transform.h"
@@ -320,23 +320,13 @@ TEST_F(Inspection, ReportTextIsTheErrorMapJsonIndentedWithANewline) {
   EXPECT_EQ(parsed["tolerance"]["verdict"], "fail");
 }
 
-// Decodes PNG bytes with libpng into packed RGB; width 0 on failure.
-RgbImage DecodePng(const std::string& bytes) {
-  png_image img{};
-  img.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_memory(&img, bytes.data(), bytes.size())) return {};
-  img.format = PNG_FORMAT_RGB;
-  RgbImage out(img.width, img.height);
-  if (!png_image_finish_read(&img, nullptr, out.pixels.data(), 0, nullptr)) return {};
-  return out;
-}
 
 TEST_F(Inspection, PngBytesAreTheMapDrawnInThePartFrame) {
   ASSERT_TRUE(result_);
   auto bytes = ErrorMapPngBytes(result_->merged.cloud_in_world, cell_->world_from_part,
                                 result_->error_map, cell_->part);
   ASSERT_TRUE(bytes.ok()) << bytes.status();
-  const RgbImage decoded = DecodePng(*bytes);
+  const RgbImage decoded = testing::DecodePng(*bytes);
   ASSERT_GT(decoded.width, 0u);
   // The same picture rendered here from the cloud mapped into the part frame.
   PointCloud in_part = PointCloud::Unorganized({});
