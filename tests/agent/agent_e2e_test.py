@@ -224,19 +224,28 @@ class AgentTests(unittest.TestCase):
         self.assert_exactly_once(parts)
 
     def test_corrupt_scan_is_quarantined_and_the_queue_goes_on(self):
-        parts = self.drop_parts(2, seed=14)
-        bad = parts[0]
+        parts = self.drop_parts(3, seed=14)
+        bad, crafted = parts[0], parts[2]
         scan = os.path.join(self.dir, "inbox", bad, "v2.pcd")
         with open(scan, "r+b") as f:
             f.truncate(os.path.getsize(scan) // 2)
+        # A header shape that used to crash the reader: a first line that is
+        # no keyword, a garbage COUNT and a second header after the first.
+        with open(os.path.join(self.dir, "inbox", crafted, "v1.pcd"), "wb") as f:
+            f.write(b"hello\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT a b c\nWIDTH 1\n"
+                    b"HEIGHT 1\nPOINTS 1\nDATA binary\n" + b"\0" * 12 +
+                    b"VERSION 0.7\nFIELDS x\nDATA ascii\n")
         server = self.server()
         code, out, err = self.agent(f"127.0.0.1:{server.port}", "--once")
-        self.assertEqual(code, 3, err)  # 3 = something was quarantined
+        self.assertEqual(code, 3, err)  # 3 = something was quarantined; the agent did not crash
         with open(os.path.join(self.dir, "quarantine", bad, "error.txt")) as f:
             why = f.read()
         self.assertIn("truncated", why)
+        with open(os.path.join(self.dir, "quarantine", crafted, "error.txt")) as f:
+            self.assertIn("v1.pcd", f.read())
         self.assertTrue(os.path.exists(os.path.join(self.dir, "results", parts[1], "report.json")))
         self.assertFalse(os.path.exists(os.path.join(self.dir, "results", bad)))
+        self.assertFalse(os.path.exists(os.path.join(self.dir, "inbox", crafted)))
 
     def test_two_replicas_round_robin_one_killed(self):
         parts = self.drop_parts(3, seed=15)
