@@ -10,7 +10,8 @@ InspectReactor::InspectReactor(InspectionService* service, grpc::CallbackServerC
     : service_(service),
       ctx_(ctx),
       request_id_(service->RequestId(ctx)),
-      start_(std::chrono::steady_clock::now()) {}
+      start_(std::chrono::steady_clock::now()),
+      reader_(service->config().limits, ReaderHooks()) {}
 
 grpc::ServerBidiReactor<v1::InspectRequest, v1::InspectResponse>* InspectionService::Inspect(
     grpc::CallbackServerContext* ctx) {
@@ -44,121 +45,39 @@ grpc::Status InspectReactor::HandleRead(bool ok) {
   if (grpc::Status st = Consume(&in_); !st.ok()) return st;
   std::lock_guard<std::mutex> lock(mu_);
   if (finish_requested_) return grpc::Status::OK;
-  if (state_ != State::kEnded) {
+  if (!reader_.ended()) {
     StartRead(&in_);
     return grpc::Status::OK;
   }
   return SubmitComputeLocked();
 }
 
+// A hook's own grpc::Status (its code, message and trailing metadata as the
+// service set them) is returned as it is; the reader's statuses go through ToGrpc.
 grpc::Status InspectReactor::Consume(v1::InspectRequest* msg) {
-  switch (msg->message_case()) {
-    case v1::InspectRequest::kPart:
-      return ConsumePart(msg->mutable_part());
-    case v1::InspectRequest::kView:
-      return ConsumeView(msg->view());
-    case v1::InspectRequest::kChunk:
-      return ConsumeChunk(msg->chunk());
-    case v1::InspectRequest::kEnd:
-      return ConsumeEnd();
-    default:
-      return InvalidField("message", "empty InspectRequest");
-  }
+  hook_status_ = grpc::Status::OK;
+  const absl::Status st = reader_.Consume(msg);
+  if (st.ok()) return grpc::Status::OK;
+  return hook_status_.ok() ? ToGrpc(st) : hook_status_;
 }
 
-// Validates and parses the header into part_. The mesh moves out of the read
-// buffer, which the next read overwrites anyway.
-grpc::Status InspectReactor::ConsumePart(v1::PartHeader* header) {
-  if (state_ != State::kExpectPart) return InvalidField("part", "only one part header per stream");
-  if (header->part_id().empty() || header->part_id().size() > 256)
-    return InvalidField("part.part_id", "must be 1..256 characters");
-  if (header->part().source_case() == v1::MeshRef::SOURCE_NOT_SET)
-    return InvalidField("part.part", "mesh is missing (set inline or sha256)");
-  // A mesh sent by hash is looked up now, so a miss fails before the client
-  // streams its views; an inline mesh is indexed on the pool.
-  if (header->part().source_case() == v1::MeshRef::kSha256)
-    if (grpc::Status st = service_->ResolveMesh(ctx_, header->part(), "part.part", &part_.index);
-        !st.ok())
-      return st;
-  auto world_from_part =
-      wire::TransformFromProto(header->world_from_part(), "part.world_from_part");
-  if (!world_from_part.ok()) return ToGrpc(world_from_part.status());
-  auto error_map = wire::ErrorMapSettingsFromProto(header->error_map(), "part.error_map");
-  if (!error_map.ok()) return ToGrpc(error_map.status());
-  auto filter = wire::FilterSettingsFromProto(header->filter(), "part.filter",
-                                              LinkClusteringSettings::ForInspection());
-  if (!filter.ok()) return ToGrpc(filter.status());
-  part_.id = header->part_id();
-  part_.mesh.Swap(header->mutable_part());
-  part_.world_from_part = *world_from_part;
-  part_.settings.filter = !header->skip_filter();
-  part_.settings.filter_settings = *filter;
-  part_.settings.error_map = *error_map;
-  part_.return_deviations = header->return_deviations();
-  part_.return_png = header->return_png();
-  state_ = State::kExpectView;
-  return grpc::Status::OK;
-}
-
-grpc::Status InspectReactor::ConsumeView(const v1::ViewHeader& view) {
-  const wire::Limits& limits = service_->config().limits;
-  if (state_ == State::kExpectPart) return InvalidField("view", "the part header must come first");
-  if (state_ == State::kInView) return IncompleteView("view", views_.empty() ? "" : "previous");
-  const std::string field = absl::StrCat("view[", views_.size(), "]");
-  if (auto st = wire::CheckCloudShape(view.width(), view.height(), field, limits); !st.ok())
-    return ToGrpc(st);
-  total_points_ += uint64_t{view.width()} * view.height();
-  if (total_points_ > limits.max_points)
-    return grpc::Status(
-        grpc::StatusCode::RESOURCE_EXHAUSTED,
-        absl::StrCat("part: ", total_points_, " points exceed the limit of ", limits.max_points));
-  auto pose = wire::TransformFromProto(view.world_from_sensor(), field + ".world_from_sensor");
-  if (!pose.ok()) return ToGrpc(pose.status());
-  ViewScan scan;
-  scan.name = view.name().empty() ? absl::StrCat("view", views_.size()) : view.name();
-  // Before a byte of the view is buffered: a part that does not fit is
-  // refused now, while the client still holds its data to send again.
-  const uint64_t view_points = uint64_t{view.width()} * view.height();
-  if (grpc::Status room =
-          service_->Reserve(view_points * InspectBytesPerPoint(),
-                            absl::StrCat("Inspect part '", part_.id, "' view '", scan.name, "'"),
-                            &reserved_.emplace_back());
-      !room.ok())
-    return room;
-  scan.world_from_sensor = *pose;
-  views_.push_back(std::move(scan));
-  view_cloud_.Start(view.width(), view.height());
-  state_ = State::kInView;
-  return grpc::Status::OK;
-}
-
-grpc::Status InspectReactor::ConsumeChunk(const v1::CloudChunk& chunk) {
-  if (state_ != State::kInView) return InvalidField("chunk", "a chunk must follow a view header");
-  const std::string field = absl::StrCat("view '", views_.back().name, "'");
-  if (auto st = view_cloud_.Add(chunk.xyz(), field); !st.ok()) return ToGrpc(st);
-  if (!view_cloud_.complete()) return grpc::Status::OK;
-  auto cloud = view_cloud_.Take(field);
-  if (!cloud.ok()) return ToGrpc(cloud.status());
-  views_.back().cloud_in_sensor = *std::move(cloud);
-  state_ = State::kExpectView;
-  SendProgress(v1::Progress::STAGE_VIEW_RECEIVED, views_.back().name,
-               views_.back().cloud_in_sensor.size());
-  return grpc::Status::OK;
-}
-
-grpc::Status InspectReactor::ConsumeEnd() {
-  if (state_ == State::kInView) return IncompleteView("end", views_.back().name);
-  if (state_ != State::kExpectView || views_.empty())
-    return InvalidField("end", "a part header and at least one view must come first");
-  state_ = State::kEnded;
-  return grpc::Status::OK;
-}
-
-grpc::Status InspectReactor::IncompleteView(const std::string& field,
-                                            const std::string& name) const {
-  return InvalidField(
-      field, absl::StrCat("view '", name, "' is incomplete: ", view_cloud_.received_bytes(), " of ",
-                          view_cloud_.expected_bytes(), " bytes"));
+wire::InspectStreamReader::Hooks InspectReactor::ReaderHooks() {
+  wire::InspectStreamReader::Hooks hooks;
+  hooks.resolve_mesh = [this](const v1::MeshRef& mesh, const std::string& field) {
+    hook_status_ = service_->ResolveMesh(ctx_, mesh, field, &part_index_);
+    return hook_status_.ok() ? absl::OkStatus() : absl::AbortedError("resolve_mesh");
+  };
+  hooks.reserve_view = [this](uint64_t view_points, const std::string& view_name) {
+    hook_status_ = service_->Reserve(
+        view_points * InspectBytesPerPoint(),
+        absl::StrCat("Inspect part '", reader_.part().id, "' view '", view_name, "'"),
+        &reserved_.emplace_back());
+    return hook_status_.ok() ? absl::OkStatus() : absl::AbortedError("reserve_view");
+  };
+  hooks.view_received = [this](const std::string& view_name, uint64_t points) {
+    SendProgress(v1::Progress::STAGE_VIEW_RECEIVED, view_name, points);
+  };
+  return hooks;
 }
 
 // computing_ is set with the submission, under the lock that Finish needs;
@@ -185,21 +104,22 @@ void InspectReactor::Compute() {
 
 // Parse (done at the header) -> core (InspectPart) -> convert; sends the result.
 grpc::Status InspectReactor::RunInspection() {
-  std::shared_ptr<const MeshIndex> index = part_.index;
+  const wire::InspectPart& part = reader_.part();
+  std::shared_ptr<const MeshIndex> index = part_index_;
   if (!index)
-    if (grpc::Status st = service_->ResolveMesh(ctx_, part_.mesh, "part.part", &index); !st.ok())
+    if (grpc::Status st = service_->ResolveMesh(ctx_, part.mesh, "part.part", &index); !st.ok())
       return st;
   auto progress = [this](InspectionStage stage, const std::string& view, std::size_t points) {
     SendProgress(wire::StageToProto(stage), view, points);
   };
-  auto result = InspectPart(*index, part_.world_from_part, std::move(views_), part_.settings,
+  auto result = InspectPart(*index, part.world_from_part, std::move(reader_.views()), part.settings,
                             progress, &cancel_.flag());
   if (!result.ok()) return ToGrpc(result.status());
   v1::InspectResponse resp;
-  wire::InspectionResultToProto(part_.id, *result, part_.settings.error_map,
-                                part_.return_deviations, resp.mutable_result());
-  if (part_.return_png) {
-    auto png = ErrorMapPngBytes(result->merged.cloud_in_world, part_.world_from_part,
+  wire::InspectionResultToProto(part.id, *result, part.settings.error_map, part.return_deviations,
+                                resp.mutable_result());
+  if (part.return_png) {
+    auto png = ErrorMapPngBytes(result->merged.cloud_in_world, part.world_from_part,
                                 result->error_map, index->mesh());
     if (!png.ok()) return ToGrpc(png.status());
     resp.mutable_result()->set_png(*std::move(png));
@@ -280,10 +200,10 @@ void InspectReactor::MaybeFinishLocked() {
 void InspectReactor::LogAndCountLocked() {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  service_->LogCall(request_id_, "Inspect", ctx_->peer(), total_points_, final_status_, seconds,
-                    cancel_.MillisecondsSinceRaised());
+  service_->LogCall(request_id_, "Inspect", ctx_->peer(), reader_.total_points(), final_status_,
+                    seconds, cancel_.MillisecondsSinceRaised());
   service_->metrics()->RecordRpc("Inspect", CodeName(final_status_.error_code()), seconds);
-  if (final_status_.ok()) service_->metrics()->AddPoints(total_points_);
+  if (final_status_.ok()) service_->metrics()->AddPoints(reader_.total_points());
 }
 
 }  // namespace surfinspect::server

@@ -1,7 +1,8 @@
 // InspectReactor: the state of one bidirectional Inspect stream. Reading
-// side: part header (parsed once into typed settings), then per view a
-// header and ~1 MB chunks, then the end marker, validated as they come
-// (sizes against limits before any byte is buffered). Compute side: on the
+// side: wire::InspectStreamReader (proto/inspect_stream.h) takes the part
+// header, the view headers with their ~1 MB chunks and the end marker,
+// validated as they come; the reactor's hooks look a mesh up by hash,
+// reserve each view's memory and report each view received. Compute side: on the
 // work pool, InspectPart (core/pipeline/inspection) with progress events
 // streamed back, then the result. Writes go through a queue (one outstanding
 // write at a time); Finish happens exactly once, and never while the pool job
@@ -21,7 +22,7 @@
 #include <vector>
 
 #include "core/pipeline/inspection.h"
-#include "core/registration/registration.h"
+#include "proto/inspect_stream.h"
 #include "server/cancel_signal.h"
 #include "server/inspection_service.h"
 
@@ -39,26 +40,10 @@ class InspectReactor final
   void OnDone() override { delete this; }
 
  private:
-  enum class State { kExpectPart, kExpectView, kInView, kEnded };
-  // The stream's part header, parsed and validated once when it arrives.
-  struct Part {
-    std::string id;
-    v1::MeshRef mesh;                        // indexed on the pool when inline
-    std::shared_ptr<const MeshIndex> index;  // resolved at the header when sent by hash
-    Eigen::Isometry3d world_from_part = Eigen::Isometry3d::Identity();
-    InspectionSettings settings;
-    bool return_deviations = false;
-    bool return_png = false;
-  };
-
   // Reading side.
   grpc::Status HandleRead(bool ok);
   grpc::Status Consume(v1::InspectRequest* msg);
-  grpc::Status ConsumePart(v1::PartHeader* header);
-  grpc::Status ConsumeView(const v1::ViewHeader& view);
-  grpc::Status ConsumeChunk(const v1::CloudChunk& chunk);
-  grpc::Status ConsumeEnd();
-  grpc::Status IncompleteView(const std::string& field, const std::string& name) const;
+  wire::InspectStreamReader::Hooks ReaderHooks();
   grpc::Status SubmitComputeLocked();
   // Compute side (the pool job).
   void Compute();
@@ -84,11 +69,9 @@ class InspectReactor final
   // Reading side (only touched by OnReadDone, which gRPC serialises, and then
   // by the pool job, which starts after the last read).
   v1::InspectRequest in_;
-  State state_ = State::kExpectPart;
-  Part part_;
-  std::vector<ViewScan> views_;
-  wire::CloudAssembler view_cloud_;  // the view whose chunks are arriving
-  uint64_t total_points_ = 0;
+  wire::InspectStreamReader reader_;             // the part header and the views
+  std::shared_ptr<const MeshIndex> part_index_;  // resolved at the header when sent by hash
+  grpc::Status hook_status_;                     // a hook's own failure, returned as it is
 
   // Writing side and finish bookkeeping.
   std::mutex mu_;
