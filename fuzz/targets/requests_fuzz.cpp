@@ -28,12 +28,9 @@ wire::Limits FuzzLimits() {
 }
 
 // What ResolveMesh converts: an inline mesh through MeshFromProto; a hash
-// is only looked up. Inline meshes with an empty vertex or triangle array
-// are skipped: MeshFromProto's copy of an empty array is tested in
-// tests/proto, and here it would stop UBSan before the rest is reached.
+// is only looked up.
 void ConvertMesh(const v1::MeshRef& ref, const std::string& field) {
   if (!ref.has_inline_()) return;
-  if (ref.inline_().vertices().empty() || ref.inline_().triangles().empty()) return;
   (void)wire::MeshFromProto(ref.inline_(), field + ".inline", FuzzLimits());
 }
 
