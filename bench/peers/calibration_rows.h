@@ -85,6 +85,18 @@ struct PeerResult {
   Eigen::Isometry3d gauge_from_sensor = Eigen::Isometry3d::Identity();
 };
 
+// The same stopping rules for both PCL ICP variants: 100 iterations, no
+// early stop on small steps, correspondences within the gate.
+template <typename Icp, typename Cloud>
+void ConfigurePclIcp(Icp& icp, const Cloud& source, const Cloud& target, double gate_mm) {
+  icp.setInputSource(source);
+  icp.setInputTarget(target);
+  icp.setMaxCorrespondenceDistance(gate_mm);
+  icp.setMaximumIterations(100);
+  icp.setTransformationEpsilon(1e-10);
+  icp.setEuclideanFitnessEpsilon(1e-10);
+}
+
 inline PeerResult PclPointToPoint(const std::vector<Eigen::Vector3f>& src, const Sample& tgt,
                                   const Eigen::Isometry3d& init, double gate_mm) {
   auto s = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
@@ -94,12 +106,7 @@ inline PeerResult PclPointToPoint(const std::vector<Eigen::Vector3f>& src, const
   PeerResult r;
   r.seconds = MedianSeconds(1, false, [&] {
     pcl::IterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ> icp;
-    icp.setInputSource(s);
-    icp.setInputTarget(t);
-    icp.setMaxCorrespondenceDistance(gate_mm);
-    icp.setMaximumIterations(100);
-    icp.setTransformationEpsilon(1e-10);
-    icp.setEuclideanFitnessEpsilon(1e-10);
+    ConfigurePclIcp(icp, s, t, gate_mm);
     pcl::PointCloud<pcl::PointXYZ> out;
     icp.align(out, init.matrix().cast<float>());
     r.gauge_from_sensor.matrix() = icp.getFinalTransformation().cast<double>();
@@ -125,12 +132,7 @@ inline PeerResult PclPointToPlane(const std::vector<Eigen::Vector3f>& src, const
   PeerResult r;
   r.seconds = MedianSeconds(1, false, [&] {
     pcl::IterativeClosestPointWithNormals<P, P> icp;  // point-to-plane LLS on the target normals
-    icp.setInputSource(s);
-    icp.setInputTarget(t);
-    icp.setMaxCorrespondenceDistance(gate_mm);
-    icp.setMaximumIterations(100);
-    icp.setTransformationEpsilon(1e-10);
-    icp.setEuclideanFitnessEpsilon(1e-10);
+    ConfigurePclIcp(icp, s, t, gate_mm);
     pcl::PointCloud<P> out;
     icp.align(out, init.matrix().cast<float>());
     r.gauge_from_sensor.matrix() = icp.getFinalTransformation().cast<double>();
