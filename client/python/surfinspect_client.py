@@ -13,7 +13,9 @@ import hashlib
 import json
 import math
 import os
+import random
 import struct
+import time
 
 import grpc
 
@@ -330,8 +332,36 @@ def load_views(cell, scans_dir):
     return views
 
 
+# Codes a later call may not get: the server (or every replica) was busy,
+# out of memory budget, unreachable or too slow. The C++ clients retry the
+# same set (client/remote/remote_client.cpp IsRetryable).
+RETRYABLE = (grpc.StatusCode.RESOURCE_EXHAUSTED, grpc.StatusCode.UNAVAILABLE,
+             grpc.StatusCode.DEADLINE_EXCEEDED, grpc.StatusCode.ABORTED)
+
+
+def backoff_wait(retry, initial_s=0.5, max_s=15.0, rng=random):
+    """The wait before retry `retry` (0 = the first), s: exponential backoff
+    with full jitter (Brooker, "Exponential Backoff And Jitter", 2015),
+    uniform in [0, min(max_s, initial_s * 2**retry)], as the cell-agent does."""
+    return rng.uniform(0.0, min(max_s, initial_s * 2.0 ** min(retry, 60)))
+
+
+def _stream_part(stub, header, views, timeout_s, metadata, on_progress):
+    result = None
+    for resp in stub.Inspect(_requests(header, views), timeout=timeout_s, metadata=metadata,
+                             wait_for_ready=True):
+        if resp.HasField("progress") and on_progress:
+            on_progress(resp.progress)
+        if resp.HasField("result"):
+            result = resp.result
+    if result is None:
+        raise ClientError("Inspect stream ended without a result")
+    return result
+
+
 def inspect_part(channel, cell, scans_dir, part_id, token=None, timeout_s=300, on_progress=None,
-                 mesh="auto"):
+                 mesh="auto", max_attempts=8, backoff_initial_s=0.5, backoff_max_s=15.0,
+                 on_retry=None, sleep=time.sleep):
     """Streams one part to Inspect and returns the InspectResult.
 
     mesh: "inline", "hash", or "auto" (inline when the mesh is at most 1/8
@@ -339,7 +369,12 @@ def inspect_part(channel, cell, scans_dir, part_id, token=None, timeout_s=300, o
     not cached the mesh answers FAILED_PRECONDITION "MESH_NOT_CACHED" and the
     part is sent again with the mesh inline; under round_robin that retry
     lands on another replica, which is why small meshes go inline at once.
-    Raises grpc.RpcError for failed calls.
+
+    A call that fails with a RETRYABLE code (a server out of memory budget
+    answers RESOURCE_EXHAUSTED before the clouds are buffered) is made again
+    after backoff_wait(), up to max_attempts calls in all (0 = no limit);
+    on_retry(error, calls_so_far, wait_s) is told before each wait.
+    timeout_s bounds each call. Raises grpc.RpcError for failed calls.
     """
     vertices, triangles = read_stl(cell["part_mesh"])
     views = load_views(cell, scans_dir)
@@ -354,21 +389,21 @@ def inspect_part(channel, cell, scans_dir, part_id, token=None, timeout_s=300, o
         mesh = "inline" if len(vertices) + len(triangles) <= cloud_bytes // 8 else "hash"
     if mesh not in ("hash", "inline"):
         raise ClientError(f"mesh must be auto, hash or inline, not {mesh!r}")
-    for mesh_ref in ((by_hash, inline) if mesh == "hash" else (inline,)):
-        result = None
+    mesh_ref = by_hash if mesh == "hash" else inline
+    calls = 0
+    while True:
+        calls += 1
         try:
-            for resp in stub.Inspect(_requests(_header(cell, part_id, mesh_ref), views), timeout=timeout_s,
-                                     metadata=metadata, wait_for_ready=True):
-                if resp.HasField("progress") and on_progress:
-                    on_progress(resp.progress)
-                if resp.HasField("result"):
-                    result = resp.result
+            return _stream_part(stub, _header(cell, part_id, mesh_ref), views, timeout_s, metadata,
+                                on_progress)
         except grpc.RpcError as e:
             if mesh_ref is by_hash and e.code() == grpc.StatusCode.FAILED_PRECONDITION and \
                     (e.details() or "").startswith("MESH_NOT_CACHED"):
+                mesh_ref, calls = inline, calls - 1  # not a failure: send the mesh along
                 continue
-            raise
-        if result is None:
-            raise ClientError("Inspect stream ended without a result")
-        return result
-    raise AssertionError("unreachable")
+            if e.code() not in RETRYABLE or (max_attempts and calls >= max_attempts):
+                raise
+            wait = backoff_wait(calls - 1, backoff_initial_s, backoff_max_s)
+            if on_retry:
+                on_retry(e, calls, wait)
+            sleep(wait)

@@ -293,6 +293,29 @@ class PythonClientTest(unittest.TestCase):
             with self.assertRaisesRegex(sc.ClientError, f"{section}.{key}", msg=f"{key}={value!r}"):
                 sc._header(cell, "p", None)
 
+    def test_resource_exhausted_is_retried_with_jittered_backoff_up_to_max_attempts(self):
+        import grpc
+        import surfinspect_client as sc
+        # A 1 MiB budget refuses the demo part's views at every call.
+        self.server = Server("--auth-token-file", self.token, "--max-memory-mb", "1")
+        with open(self.token) as f:
+            token = f.read().strip()
+        waits, retries = [], []
+        with sc.connect(self.server.target) as channel:
+            with self.assertRaises(grpc.RpcError) as ctx:
+                sc.inspect_part(channel, sc.read_cell(self.cell), self.scans, "part-001", token=token,
+                                max_attempts=4, backoff_initial_s=0.5, backoff_max_s=0.75,
+                                on_retry=lambda e, calls, wait: retries.append((e.code(), calls)),
+                                sleep=waits.append)
+        self.assertEqual(ctx.exception.code(), grpc.StatusCode.RESOURCE_EXHAUSTED)
+        self.assertIn("memory budget", ctx.exception.details())
+        self.assertEqual(retries, [(grpc.StatusCode.RESOURCE_EXHAUSTED, n) for n in (1, 2, 3)])
+        # Full jitter: retry n waits uniform in [0, min(max, initial * 2^n)].
+        self.assertEqual(len(waits), 3)
+        for wait, cap in zip(waits, (0.5, 0.75, 0.75)):
+            self.assertTrue(0 <= wait <= cap, (wait, cap))
+        self.assertEqual(self.server.rpcs("Inspect", ("RESOURCE_EXHAUSTED", "8")), 4)
+
 
 if __name__ == "__main__":
     BIN = os.path.abspath(sys.argv[1])
