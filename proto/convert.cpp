@@ -274,9 +274,9 @@ void MergedCloudToProto(const MergedCloud& merged, v1::RegisterResponse* msg) {
 const char* VerdictName(const ErrorMapResult& map) { return map.verdict.pass ? "pass" : "fail"; }
 
 void ErrorMapToProto(const ErrorMapResult& map, const ErrorMapSettings& settings,
-                     bool with_deviations, v1::ErrorMapResponse* msg) {
-  msg->set_report_json(ErrorMapReportText(map, settings));
-  msg->set_verdict(VerdictName(map));
+                     const PlanOutcome& outcome, bool with_deviations, v1::ErrorMapResponse* msg) {
+  msg->set_report_json(ErrorMapReportText(map, settings, outcome));
+  msg->set_verdict(outcome.pass() ? "pass" : "fail");
   if (with_deviations) msg->set_deviations(PackFloats(map.deviation_mm));
 }
 
@@ -290,8 +290,8 @@ void InspectionResultToProto(const std::string& part_id, const InspectionResult&
                              const ErrorMapSettings& settings, bool with_deviations,
                              v1::InspectResult* msg) {
   msg->set_part_id(part_id);
-  msg->set_verdict(VerdictName(result.error_map));
-  msg->set_report_json(ErrorMapReportText(result.error_map, settings));
+  msg->set_verdict(result.plan.pass() ? "pass" : "fail");
+  msg->set_report_json(ErrorMapReportText(result.error_map, settings, result.plan));
   msg->clear_views();
   for (const ViewOutcome& v : result.views) ViewOutcomeToProto(v, msg->add_views());
   if (with_deviations) {

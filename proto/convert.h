@@ -98,10 +98,11 @@ void FilterResultToProto(const PointCloud& filtered, const LinkClusteringResult&
 void MergedCloudToProto(const MergedCloud& merged, v1::RegisterResponse* msg);
 // "pass" or "fail", as in the JSON report.
 const char* VerdictName(const ErrorMapResult& map);
-// The report JSON text, the verdict and, when `with_deviations`, the
-// per-point deviations. The PNG is the caller's.
+// The report JSON text (surfinspect.report/2), the part verdict of
+// `outcome` and, when `with_deviations`, the per-point deviations. The PNG
+// is the caller's.
 void ErrorMapToProto(const ErrorMapResult& map, const ErrorMapSettings& settings,
-                     bool with_deviations, v1::ErrorMapResponse* msg);
+                     const PlanOutcome& outcome, bool with_deviations, v1::ErrorMapResponse* msg);
 void ViewOutcomeToProto(const ViewOutcome& view, v1::ViewSummary* msg);
 // As ErrorMapToProto, plus the part id and the per-view summaries; with
 // `with_deviations` also the merged cloud (world frame) they belong to.

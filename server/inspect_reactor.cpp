@@ -200,7 +200,7 @@ grpc::Status InspectReactor::RunInspection() {
                                 part_.return_deviations, resp.mutable_result());
   if (part_.return_png) {
     auto png = ErrorMapPngBytes(result->merged.cloud_in_world, part_.world_from_part,
-                                result->error_map, index->mesh());
+                                result->error_map, index->mesh(), result->plan);
     if (!png.ok()) return ToGrpc(png.status());
     resp.mutable_result()->set_png(*std::move(png));
   }

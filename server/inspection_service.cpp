@@ -331,9 +331,12 @@ grpc::ServerUnaryReactor* InspectionService::ErrorMap(grpc::CallbackServerContex
     if (grpc::Status st = ResolveMesh(ctx, req->part(), "part", &part); !st.ok()) return st;
     auto map = ComputeErrorMap(*part, *cloud, *world_from_part, *settings, &cancel);
     if (!map.ok()) return FromCore(map.status());
-    wire::ErrorMapToProto(*map, *settings, req->return_deviations(), resp);
+    auto outcome =
+        EvaluatePlan(*map, *cloud, part->mesh(), PlanFromSettings(*settings), settings->threads);
+    if (!outcome.ok()) return FromCore(outcome.status());
+    wire::ErrorMapToProto(*map, *settings, *outcome, req->return_deviations(), resp);
     if (req->return_png()) {
-      auto png = ErrorMapPngBytes(*cloud, *world_from_part, *map, part->mesh());
+      auto png = ErrorMapPngBytes(*cloud, *world_from_part, *map, part->mesh(), *outcome);
       if (!png.ok()) return FromCore(png.status());
       resp->set_png(*std::move(png));
     }

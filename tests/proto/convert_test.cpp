@@ -150,15 +150,22 @@ ErrorMapResult SmallMap(bool pass) {
   return map;
 }
 
+// The part verdict of a plan outcome.
+PlanOutcome Outcome(bool pass) {
+  PlanOutcome o;
+  o.characteristics.pass = pass;
+  return o;
+}
+
 TEST(ErrorMapToProto, ReportVerdictAndDeviationsOnlyWhenAsked) {
   const ErrorMapSettings settings;
   v1::ErrorMapResponse with;
-  ErrorMapToProto(SmallMap(true), settings, true, &with);
+  ErrorMapToProto(SmallMap(true), settings, Outcome(true), true, &with);
   EXPECT_EQ(with.verdict(), "pass");
-  EXPECT_EQ(with.report_json(), ErrorMapReportText(SmallMap(true), settings));
+  EXPECT_EQ(with.report_json(), ErrorMapReportText(SmallMap(true), settings, Outcome(true)));
   EXPECT_EQ(with.deviations(), PackFloats(SmallMap(true).deviation_mm));
   v1::ErrorMapResponse without;
-  ErrorMapToProto(SmallMap(false), settings, false, &without);
+  ErrorMapToProto(SmallMap(false), settings, Outcome(false), false, &without);
   EXPECT_EQ(without.verdict(), "fail");
   EXPECT_TRUE(without.deviations().empty());
   EXPECT_TRUE(without.png().empty()) << "the caller's";
@@ -169,13 +176,14 @@ TEST(InspectionResultToProto, PartIdVerdictReportViewsAndOptionalDeviations) {
   r.error_map = SmallMap(false);
   r.merged.cloud_in_world = PointCloud::Unorganized({{1, 2, 3}, {4, 5, 6}, {7, 8, 9}});
   r.views = {{"top", 1200, 7}, {"side", 800, 0}};
+  r.plan = Outcome(false);
   ErrorMapSettings settings;
   settings.tolerance_mm = 0.25;
   v1::InspectResult msg;
   InspectionResultToProto("part-7", r, settings, true, &msg);
   EXPECT_EQ(msg.part_id(), "part-7");
   EXPECT_EQ(msg.verdict(), "fail");
-  EXPECT_EQ(msg.report_json(), ErrorMapReportText(r.error_map, settings));
+  EXPECT_EQ(msg.report_json(), ErrorMapReportText(r.error_map, settings, r.plan));
   ASSERT_EQ(msg.views_size(), 2);
   EXPECT_EQ(msg.views(0).name(), "top");
   EXPECT_EQ(msg.views(0).valid_points(), 1200u);

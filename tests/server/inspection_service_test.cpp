@@ -142,7 +142,10 @@ TEST(InspectionService, EveryRpcMatchesInProcess) {
     differing += std::memcmp(&remote_dev[i], &local_map.deviation_mm[i], 4) != 0;
   EXPECT_EQ(differing, 0u);
   nlohmann::json remote_report = nlohmann::json::parse(eresp->report_json());
-  nlohmann::json local_report = nlohmann::json::parse(ErrorMapReportText(local_map, {}));
+  const PlanOutcome local_outcome =
+      *EvaluatePlan(local_map, d.merged_world, d.cell.part, PlanFromSettings({}));
+  nlohmann::json local_report =
+      nlohmann::json::parse(ErrorMapReportText(local_map, {}, local_outcome));
   remote_report.erase("timing");
   local_report.erase("timing");
   EXPECT_EQ(remote_report, local_report);
