@@ -88,6 +88,16 @@ grpc::Status InspectReactor::ConsumePart(v1::PartHeader* header) {
   auto filter = wire::FilterSettingsFromProto(header->filter(), "part.filter",
                                               LinkClusteringSettings::ForInspection());
   if (!filter.ok()) return ToGrpc(filter.status());
+  // The plan's values are checked against the mesh here when it came by
+  // hash, else by InspectPart once the inline mesh is indexed.
+  if (header->has_plan()) {
+    auto plan = wire::PlanFromProto(header->plan(), *error_map, "part.plan");
+    if (!plan.ok()) return ToGrpc(plan.status());
+    if (part_.index)
+      if (auto st = ValidateInspectionPlan(*plan, part_.index->mesh(), {}, "part.plan"); !st.ok())
+        return ToGrpc(st);
+    part_.settings.plan = *std::move(plan);
+  }
   part_.id = header->part_id();
   part_.mesh.Swap(header->mutable_part());
   part_.world_from_part = *world_from_part;

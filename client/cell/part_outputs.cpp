@@ -69,7 +69,9 @@ absl::StatusOr<PartOutputs> OutputsFromLocal(const std::string& part_id, const I
 absl::StatusOr<PartOutputs> OutputsFromRemote(const v1::InspectResult& r) {
   PartOutputs o;
   o.part_id = r.part_id();
-  o.verdict = r.verdict();
+  o.verdict = r.part_verdict() == v1::VERDICT_PASS ? "pass" : "fail";
+  o.failed = FailedLines(wire::CharacteristicsFromProto(r.characteristics()));
+  o.defects = DefectLines(wire::DefectsFromProto(r.defects()));
   o.report_json = r.report_json();
   o.png = r.png();
   auto merged =
@@ -94,6 +96,7 @@ v1::PartHeader MakePartHeader(const std::string& part_id, const Eigen::Isometry3
   header.set_skip_filter(!settings.filter);
   header.set_return_deviations(true);
   header.set_return_png(true);
+  if (settings.plan) wire::PlanToProto(*settings.plan, header.mutable_plan());
   return header;
 }
 

@@ -55,13 +55,15 @@ struct ErrorMapRun {
 // report and PNG are its bytes (so both paths write the same files, timing
 // aside).
 ErrorMapRun RemoteErrorMap(const ErrorMapArgs& a, const PointCloud& cloud_in_world,
-                           const Eigen::Isometry3d& world_from_part, const TriangleMesh& mesh) {
+                           const Eigen::Isometry3d& world_from_part, const TriangleMesh& mesh,
+                           const InspectionPlan& plan) {
   if (a.settings.split_components) throw CommandFailed("--split-components is in-process only");
   if (!a.png.empty() && a.png_axis != "auto") throw CommandFailed("--png-axis is in-process only");
   v1::ErrorMapRequest req;
   wire::CloudToProto(cloud_in_world, req.mutable_cloud());
   wire::TransformToProto(world_from_part, req.mutable_world_from_part());
   wire::ErrorMapSettingsToProto(a.settings, req.mutable_settings());
+  if (!a.plan.empty()) wire::PlanToProto(plan, req.mutable_plan());
   req.set_return_deviations(true);
   req.set_return_png(!a.png.empty());
   const v1::ErrorMapResponse resp = Take(Connect(a.remote)->ErrorMap(req, mesh));
@@ -74,6 +76,8 @@ ErrorMapRun RemoteErrorMap(const ErrorMapArgs& a, const PointCloud& cloud_in_wor
   run.result.tolerance_mm = Number(run.report["tolerance"], "band_mm");
   run.result.color_range_mm = Number(run.report, "color_range_mm");
   run.png_bytes = resp.png();
+  run.failed = client::FailedLines(wire::CharacteristicsFromProto(resp.characteristics()));
+  run.defects = client::DefectLines(wire::DefectsFromProto(resp.defects()));
   return run;
 }
 
@@ -142,7 +146,6 @@ void RunErrorMap(const ErrorMapArgs& a) {
   const InspectionPlan plan = a.plan.empty()
                                   ? PlanFromSettings(a.settings)
                                   : Take(ParsePlanWithDefaults(plan_json, mesh, a.settings));
-  if (a.remote.remote() && !a.plan.empty()) throw CommandFailed("--plan is in-process only");
   spdlog::info("read {} points and {} triangles in {:.3f} s", cloud_in_world.size(),
                mesh.num_triangles(), Seconds(t0));
   const MeshTopology topo = AnalyzeTopology(mesh);
@@ -151,9 +154,10 @@ void RunErrorMap(const ErrorMapArgs& a) {
                                     {"nonmanifold_edges", topo.nonmanifold_edges},
                                     {"degenerate_triangles", mesh.CountDegenerate()}};
   const PointCloud cloud_in_part = TransformCloud(cloud_in_world, world_from_part.inverse());
-  ErrorMapRun run = a.remote.remote() ? RemoteErrorMap(a, cloud_in_world, world_from_part, mesh)
-                                      : LocalErrorMap(a, cloud_in_world, cloud_in_part,
-                                                      world_from_part, std::move(mesh), topo, plan);
+  ErrorMapRun run = a.remote.remote()
+                        ? RemoteErrorMap(a, cloud_in_world, world_from_part, mesh, plan)
+                        : LocalErrorMap(a, cloud_in_world, cloud_in_part, world_from_part,
+                                        std::move(mesh), topo, plan);
   // Files carry part-frame coordinates by default, so they overlay the CAD.
   const PointCloud& written = a.frame == "world" ? cloud_in_world : cloud_in_part;
   Check(WriteErrorMapPly(a.out, written, run.result, a.frame));
