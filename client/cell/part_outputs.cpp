@@ -69,7 +69,10 @@ absl::StatusOr<PartOutputs> OutputsFromLocal(const std::string& part_id, const I
 absl::StatusOr<PartOutputs> OutputsFromRemote(const v1::InspectResult& r) {
   PartOutputs o;
   o.part_id = r.part_id();
-  o.verdict = r.part_verdict() == v1::VERDICT_PASS ? "pass" : "fail";
+  // A server without the typed verdict (VERDICT_UNSPECIFIED) still sends the string.
+  o.verdict = r.part_verdict() == v1::VERDICT_UNSPECIFIED ? r.verdict()
+              : r.part_verdict() == v1::VERDICT_PASS      ? "pass"
+                                                          : "fail";
   o.failed = FailedLines(wire::CharacteristicsFromProto(r.characteristics()));
   o.defects = DefectLines(wire::DefectsFromProto(r.defects()));
   o.report_json = r.report_json();
