@@ -100,6 +100,7 @@ ErrorMapRun LocalErrorMap(const ErrorMapArgs& a, const PointCloud& cloud_in_worl
   if (!a.png.empty()) {
     ErrorMapPngOptions png;
     png.defects = &outcome.defects.defects;
+    png.part_pass = outcome.pass();
     png.view_axis = a.png_axis == "x" ? 0 : a.png_axis == "y" ? 1 : a.png_axis == "z" ? 2 : -1;
     run.png_bytes = Take(EncodePng(
         Take(RenderErrorMap(cloud_in_part, run.result, ComputeBounds(index->mesh()), png))));

@@ -150,9 +150,9 @@ std::string Label(double v, double range) {
 
 // Verdict text, colour bar with labels, and the histogram on the same
 // vertical deviation axis, drawn at x0.
-void DrawPanel(RgbImage& img, int x0, const ErrorMapResult& r) {
+void DrawPanel(RgbImage& img, int x0, const ErrorMapResult& r, bool pass) {
   const Verdict& v = r.verdict;
-  img.DrawText(x0 + 10, 10, v.pass ? "pass" : "fail", v.pass ? Rgb{0, 140, 0} : Rgb{200, 0, 0}, 3);
+  img.DrawText(x0 + 10, 10, pass ? "pass" : "fail", pass ? Rgb{0, 140, 0} : Rgb{200, 0, 0}, 3);
   const double range = r.color_range_mm;
   img.DrawText(x0 + 10, 40, absl::StrCat("tol +-", Label(r.tolerance_mm, range).substr(1), " mm"),
                kBlack, 2);
@@ -228,7 +228,8 @@ absl::StatusOr<RgbImage> RenderErrorMap(const PointCloud& points, const ErrorMap
   if (options.defects) DrawDefects(map, points, layout, *options.defects);
   RgbImage img(map.width + kPanelWidth, std::max<uint32_t>(map.height, kMinHeight), kWhite);
   for (uint32_t y = 0; y < map.height; ++y) std::copy_n(&map.at(0, y), map.width, &img.at(0, y));
-  DrawPanel(img, static_cast<int>(map.width), result);
+  DrawPanel(img, static_cast<int>(map.width), result,
+            options.part_pass.value_or(result.verdict.pass));
   return img;
 }
 

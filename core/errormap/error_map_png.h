@@ -7,6 +7,7 @@
 // by a ring at the drawn point nearest their centroid and their id.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,9 @@ struct ErrorMapPngOptions {
   int view_axis = -1;
   uint32_t max_map_pixels = 1000;                // longest side of the map panel
   const std::vector<Defect>* defects = nullptr;  // marked with their ids when given
+  // The verdict written above the panel: the part's when given (an
+  // inspection plan's), else the error map's +-tolerance verdict.
+  std::optional<bool> part_pass;
 };
 
 // Index of the smallest extent of `b` (0, 1 or 2); 2 for empty bounds.

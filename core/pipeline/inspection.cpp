@@ -66,6 +66,7 @@ absl::StatusOr<std::string> ErrorMapPngBytes(const PointCloud& cloud_in_world,
   const PointCloud in_part = TransformCloud(cloud_in_world, world_from_part.inverse());
   ErrorMapPngOptions options;
   options.defects = &outcome.defects.defects;
+  options.part_pass = outcome.pass();
   auto image = RenderErrorMap(in_part, result, ComputeBounds(part_in_part), options);
   if (!image.ok()) return image.status();
   return EncodePng(*image);

@@ -482,6 +482,21 @@ TEST(ErrorMapOutput, DefectsAreMarkedWithTheirIdsAtTheirPixel) {
   std::vector<Defect> none;
   with.defects = &none;
   EXPECT_TRUE(RenderErrorMap(f.cloud, f.result, b, with)->pixels == plain->pixels);
+  // The part verdict replaces the tolerance verdict ("fail" here) in the panel.
+  ASSERT_FALSE(f.result.verdict.pass);
+  with.part_pass = false;
+  EXPECT_TRUE(RenderErrorMap(f.cloud, f.result, b, with)->pixels == plain->pixels);
+  with.part_pass = true;
+  auto passed = RenderErrorMap(f.cloud, f.result, b, with);
+  auto green = [](const RgbImage& img) {
+    std::size_t n = 0;
+    for (uint32_t y = 0; y < 35; ++y)
+      for (uint32_t x = 400; x < img.width; ++x) n += img.at(x, y) == Rgb{0, 140, 0} ? 1 : 0;
+    return n;
+  };
+  EXPECT_GT(green(*passed), 50u) << "a green 'pass' at the panel's top";
+  EXPECT_EQ(green(*plain), 0u);
+  EXPECT_FALSE(passed->pixels == plain->pixels);
 }
 
 TEST(ErrorMapOutput, PngOfAMergedCloudLooksAlongTheThinnestAxis) {

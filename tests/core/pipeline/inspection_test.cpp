@@ -335,6 +335,7 @@ TEST_F(Inspection, PngBytesAreTheMapDrawnInThePartFrame) {
   in_part.width = static_cast<uint32_t>(in_part.points.size());
   ErrorMapPngOptions options;
   options.defects = &result_->plan.defects.defects;
+  options.part_pass = result_->plan.pass();
   auto expected = RenderErrorMap(in_part, result_->error_map, ComputeBounds(cell_->part), options);
   ASSERT_TRUE(expected.ok()) << expected.status();
   EXPECT_EQ(decoded.width, expected->width);
