@@ -4,7 +4,8 @@
 #  2. start surfinspectd on a free loopback port
 #  3. cell-agent calibrate (ICP per viewpoint on the service)
 #  4. cell-agent run --simulate 3 --once (robot drops 3 parts with dents)
-#  5. print the verdicts and where the error maps are
+#  5. print per part the verdict, the failed characteristics, the defects
+#     found and the planted ones (archive/PART/truth.json)
 #  6. stop the server (nothing is left running, even on failure)
 set -euo pipefail
 BIN=$(cd "${1:?bin dir}" && pwd)
@@ -42,9 +43,30 @@ cd "$OUT"
 "$BIN/cell-agent" run --cell cell/cell.json --server "$TARGET" --inbox inbox --results results \
   --archive archive --quarantine quarantine --simulate 3 --once
 
-say "5. Error maps"
+say "5. Results: failed characteristics, defects found and planted"
 for d in results/*/; do
   id=$(basename "$d")
-  echo "   $id: $OUT/${d}errormap.png  (planted: $(python3 -c "import json;print(', '.join('%+.3f mm r=%.1f' % (-x['depth_mm'], x['radius_mm']) for x in json.load(open('archive/$id/truth.json'))['defects']))" 2>/dev/null || echo see archive))"
+  python3 - "$d/report.json" "archive/$id/truth.json" "$OUT/${d}errormap.png" "$id" <<'PY' || echo "   $id: see $OUT/$d"
+import json, sys
+report, truth_path, png, part = sys.argv[1:]
+r = json.load(open(report))
+print("   %s: %s  (%s)" % (part, r["verdict"], png))
+for c in r["characteristics"]:
+    if c["verdict"] != "pass":
+        print("     failed %-14s %s" % (c["name"], c["reason"]))
+for f in r["defects"]:
+    x, y, z = f["centroid_mm"]
+    print("     found   #%d %-4s peak %+.3f mm at (%7.1f, %5.1f, %5.1f), %5.1f mm2%s" % (
+        f["id"], f["kind"], f["peak_mm"], x, y, z, f["area_mm2"],
+        ", " + f["region"] if f["region"] else ""))
+try:
+    planted = json.load(open(truth_path))["defects"]
+except (OSError, ValueError, KeyError):
+    planted = []
+for p in planted:
+    x, y, z = p["center_in_part"]
+    print("     planted %-8s %+.3f mm at (%7.1f, %5.1f, %5.1f), r=%.1f mm" % (
+        "dent" if p["depth_mm"] > 0 else "bump", -p["depth_mm"], x, y, z, p["radius_mm"]))
+PY
 done
 say "6. Stopping the server"

@@ -271,12 +271,281 @@ void MergedCloudToProto(const MergedCloud& merged, v1::RegisterResponse* msg) {
   for (std::size_t n : merged.points_per_view) msg->add_points_per_view(n);
 }
 
+// ---- inspection plan and results ----
+
+namespace {
+
+absl::StatusOr<Eigen::Vector3d> Vector3FromProto(const google::protobuf::RepeatedField<double>& v,
+                                                 const std::string& field) {
+  if (v.size() != 3) return Invalid(field, "must be 3 numbers");
+  return Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
+void Vector3ToProto(const Eigen::Vector3d& v, google::protobuf::RepeatedField<double>* out) {
+  out->Clear();
+  for (int a = 0; a < 3; ++a) out->Add(v[a]);
+}
+
+ToleranceBand BandFromProto(const v1::ToleranceBand& b) { return {b.lower_mm(), b.upper_mm()}; }
+
+void BandToProto(const ToleranceBand& b, v1::ToleranceBand* msg) {
+  msg->set_lower_mm(b.lower_mm);
+  msg->set_upper_mm(b.upper_mm);
+}
+
+absl::StatusOr<PlanRegion> RegionFromProto(const v1::PlanRegion& msg, const std::string& field) {
+  PlanRegion r;
+  r.name = msg.name();
+  if (msg.has_tolerance_mm()) r.tolerance = BandFromProto(msg.tolerance_mm());
+  if (msg.has_allowed_fraction_outside())
+    r.allowed_fraction_outside = msg.allowed_fraction_outside();
+  const v1::RegionSelect& s = msg.select();
+  switch (s.selector_case()) {
+    case v1::RegionSelect::kBoxMm: {
+      r.select.kind = RegionSelector::Kind::kBox;
+      auto lo = Vector3FromProto(s.box_mm().min_mm(), field + ".select.box_mm.min_mm");
+      if (!lo.ok()) return lo.status();
+      auto hi = Vector3FromProto(s.box_mm().max_mm(), field + ".select.box_mm.max_mm");
+      if (!hi.ok()) return hi.status();
+      r.select.box_min_mm = *lo;
+      r.select.box_max_mm = *hi;
+      break;
+    }
+    case v1::RegionSelect::kTriangles:
+      r.select.kind = RegionSelector::Kind::kTriangles;
+      r.select.triangles.assign(s.triangles().ids().begin(), s.triangles().ids().end());
+      break;
+    case v1::RegionSelect::kGroup:
+      r.select.kind = RegionSelector::Kind::kGroup;
+      r.select.group = s.group();
+      break;
+    default:
+      return Invalid(field + ".select", "needs exactly one selector (box_mm, triangles, group)");
+  }
+  return r;
+}
+
+absl::StatusOr<ComparisonPoint> PointFromProto(const v1::ComparisonPoint& msg,
+                                               const std::string& field) {
+  ComparisonPoint p;
+  p.name = msg.name();
+  auto pos = Vector3FromProto(msg.position_mm(), field + ".position_mm");
+  if (!pos.ok()) return pos.status();
+  p.position_mm = *pos;
+  if (msg.normal_size() != 0) {
+    auto n = Vector3FromProto(msg.normal(), field + ".normal");
+    if (!n.ok()) return n.status();
+    if (!(n->norm() > 0) || !n->allFinite())
+      return Invalid(field + ".normal", "must be a finite non-zero vector");
+    p.normal = n->normalized();
+  }
+  if (msg.has_radius_mm()) p.radius_mm = msg.radius_mm();
+  if (msg.has_tolerance_mm()) p.tolerance = BandFromProto(msg.tolerance_mm());
+  return p;
+}
+
+}  // namespace
+
+absl::StatusOr<InspectionPlan> PlanFromProto(const v1::InspectionPlan& msg,
+                                             const ErrorMapSettings& defaults,
+                                             const std::string& field) {
+  InspectionPlan plan = PlanFromSettings(defaults);
+  if (msg.has_tolerance_mm()) plan.tolerance = BandFromProto(msg.tolerance_mm());
+  if (msg.has_allowed_fraction_outside())
+    plan.allowed_fraction_outside = msg.allowed_fraction_outside();
+  for (int i = 0; i < msg.regions_size(); ++i) {
+    auto r = RegionFromProto(msg.regions(i), absl::StrCat(field, ".regions[", i, "]"));
+    if (!r.ok()) return r.status();
+    plan.regions.push_back(*std::move(r));
+  }
+  for (int i = 0; i < msg.points_size(); ++i) {
+    auto p = PointFromProto(msg.points(i), absl::StrCat(field, ".points[", i, "]"));
+    if (!p.ok()) return p.status();
+    plan.points.push_back(*std::move(p));
+  }
+  if (msg.has_defects()) {
+    DefectRules d;
+    const v1::DefectRules& m = msg.defects();
+    if (m.has_threshold_mm()) d.threshold_mm = m.threshold_mm();
+    if (m.has_min_area_mm2()) d.min_area_mm2 = m.min_area_mm2();
+    if (m.has_max_count()) d.max_count = m.max_count();
+    plan.defects = d;
+  }
+  return plan;
+}
+
+void PlanToProto(const InspectionPlan& plan, v1::InspectionPlan* msg) {
+  msg->Clear();
+  BandToProto(plan.tolerance, msg->mutable_tolerance_mm());
+  msg->set_allowed_fraction_outside(plan.allowed_fraction_outside);
+  for (const PlanRegion& r : plan.regions) {
+    v1::PlanRegion* m = msg->add_regions();
+    m->set_name(r.name);
+    if (r.tolerance) BandToProto(*r.tolerance, m->mutable_tolerance_mm());
+    m->set_allowed_fraction_outside(r.allowed_fraction_outside);
+    v1::RegionSelect* s = m->mutable_select();
+    switch (r.select.kind) {
+      case RegionSelector::Kind::kBox:
+        Vector3ToProto(r.select.box_min_mm, s->mutable_box_mm()->mutable_min_mm());
+        Vector3ToProto(r.select.box_max_mm, s->mutable_box_mm()->mutable_max_mm());
+        break;
+      case RegionSelector::Kind::kTriangles:
+        for (uint32_t t : r.select.triangles) s->mutable_triangles()->add_ids(t);
+        s->mutable_triangles();  // an empty list is still this selector
+        break;
+      case RegionSelector::Kind::kGroup:
+        s->set_group(r.select.group);
+        break;
+    }
+  }
+  for (const ComparisonPoint& p : plan.points) {
+    v1::ComparisonPoint* m = msg->add_points();
+    m->set_name(p.name);
+    Vector3ToProto(p.position_mm, m->mutable_position_mm());
+    if (p.normal != Eigen::Vector3d::Zero()) Vector3ToProto(p.normal, m->mutable_normal());
+    m->set_radius_mm(p.radius_mm);
+    if (p.tolerance) BandToProto(*p.tolerance, m->mutable_tolerance_mm());
+  }
+  if (plan.defects) {
+    v1::DefectRules* d = msg->mutable_defects();
+    d->set_threshold_mm(plan.defects->threshold_mm);
+    d->set_min_area_mm2(plan.defects->min_area_mm2);
+    if (plan.defects->max_count) d->set_max_count(*plan.defects->max_count);
+  }
+}
+
+namespace {
+
+v1::Verdict VerdictOf(bool pass) { return pass ? v1::VERDICT_PASS : v1::VERDICT_FAIL; }
+
+void StatisticsToProto(const ErrorMapResult& map, v1::ErrorMapStatistics* msg) {
+  const ErrorMapStats& s = map.stats;
+  msg->set_count(s.count);
+  msg->set_valid(s.valid);
+  msg->set_matched(s.matched);
+  msg->set_min_mm(s.min_mm);
+  msg->set_max_mm(s.max_mm);
+  msg->set_mean_mm(s.mean_mm);
+  msg->set_stddev_mm(s.stddev_mm);
+  msg->set_rms_mm(s.rms_mm);
+  msg->set_p1_mm(s.p1_mm);
+  msg->set_p5_mm(s.p5_mm);
+  msg->set_p50_mm(s.p50_mm);
+  msg->set_p95_mm(s.p95_mm);
+  msg->set_p99_mm(s.p99_mm);
+  msg->set_within(map.verdict.within);
+  msg->set_above(map.verdict.above);
+  msg->set_below(map.verdict.below);
+  msg->set_fraction_within(map.verdict.fraction_within);
+  msg->set_tolerance_verdict(VerdictOf(map.verdict.pass));
+}
+
+v1::CharacteristicType TypeToProto(CharacteristicType t) {
+  switch (t) {
+    case CharacteristicType::kSurface:
+      return v1::CHARACTERISTIC_SURFACE;
+    case CharacteristicType::kRegion:
+      return v1::CHARACTERISTIC_REGION;
+    case CharacteristicType::kPoint:
+      return v1::CHARACTERISTIC_POINT;
+  }
+  return v1::CHARACTERISTIC_TYPE_UNSPECIFIED;
+}
+
+void CharacteristicToProto(const CharacteristicResult& c, v1::CharacteristicResult* msg) {
+  msg->set_name(c.name);
+  msg->set_type(TypeToProto(c.type));
+  msg->set_verdict(VerdictOf(c.pass));
+  msg->set_reason(c.reason);
+  BandToProto(c.tolerance, msg->mutable_tolerance_mm());
+  msg->set_points(c.points);
+  msg->set_min_mm(c.min_mm);
+  msg->set_max_mm(c.max_mm);
+  msg->set_mean_mm(c.mean_mm);
+  msg->set_stddev_mm(c.stddev_mm);
+  msg->set_rms_mm(c.rms_mm);
+  msg->set_fraction_within(c.fraction_within);
+  msg->set_value_mm(c.value_mm);
+  msg->set_allowed_fraction_outside(c.allowed_fraction_outside);
+}
+
+void DefectToProto(const Defect& d, v1::DefectResult* msg) {
+  msg->set_id(d.id);
+  msg->set_kind(d.kind == DefectKind::kDent ? v1::DEFECT_DENT : v1::DEFECT_BUMP);
+  Vector3ToProto(d.centroid_mm, msg->mutable_centroid_mm());
+  msg->set_area_mm2(d.area_mm2);
+  msg->set_extent_mm(d.extent_mm);
+  msg->set_peak_mm(d.peak_mm);
+  msg->set_points(d.points);
+  msg->set_region(d.region);
+}
+
+// ErrorMapResponse and InspectResult carry the same typed fields.
+template <typename Msg>
+void OutcomeToProto(const ErrorMapResult& map, const PlanOutcome& outcome, Msg* msg) {
+  msg->set_part_verdict(VerdictOf(outcome.pass()));
+  StatisticsToProto(map, msg->mutable_statistics());
+  msg->clear_characteristics();
+  for (const CharacteristicResult& c : outcome.characteristics.characteristics)
+    CharacteristicToProto(c, msg->add_characteristics());
+  msg->clear_defects();
+  for (const Defect& d : outcome.defects.defects) DefectToProto(d, msg->add_defects());
+}
+
+}  // namespace
+
+CharacteristicsResult CharacteristicsFromProto(
+    const google::protobuf::RepeatedPtrField<v1::CharacteristicResult>& list) {
+  CharacteristicsResult out;
+  for (const v1::CharacteristicResult& m : list) {
+    CharacteristicResult c;
+    c.name = m.name();
+    c.type = m.type() == v1::CHARACTERISTIC_REGION  ? CharacteristicType::kRegion
+             : m.type() == v1::CHARACTERISTIC_POINT ? CharacteristicType::kPoint
+                                                    : CharacteristicType::kSurface;
+    c.pass = m.verdict() == v1::VERDICT_PASS;
+    c.reason = m.reason();
+    c.tolerance = BandFromProto(m.tolerance_mm());
+    c.points = m.points();
+    c.min_mm = m.min_mm();
+    c.max_mm = m.max_mm();
+    c.mean_mm = m.mean_mm();
+    c.stddev_mm = m.stddev_mm();
+    c.rms_mm = m.rms_mm();
+    c.fraction_within = m.fraction_within();
+    c.value_mm = m.value_mm();
+    c.allowed_fraction_outside = m.allowed_fraction_outside();
+    out.failed += c.pass ? 0 : 1;
+    out.characteristics.push_back(std::move(c));
+  }
+  return out;
+}
+
+DefectsResult DefectsFromProto(const google::protobuf::RepeatedPtrField<v1::DefectResult>& list) {
+  DefectsResult out;
+  for (const v1::DefectResult& m : list) {
+    Defect d;
+    d.id = m.id();
+    d.kind = m.kind() == v1::DEFECT_BUMP ? DefectKind::kBump : DefectKind::kDent;
+    if (m.centroid_mm_size() == 3)
+      d.centroid_mm = {m.centroid_mm(0), m.centroid_mm(1), m.centroid_mm(2)};
+    d.area_mm2 = m.area_mm2();
+    d.extent_mm = m.extent_mm();
+    d.peak_mm = m.peak_mm();
+    d.points = m.points();
+    d.region = m.region();
+    out.defects.push_back(std::move(d));
+  }
+  return out;
+}
+
 const char* VerdictName(const ErrorMapResult& map) { return map.verdict.pass ? "pass" : "fail"; }
 
 void ErrorMapToProto(const ErrorMapResult& map, const ErrorMapSettings& settings,
-                     bool with_deviations, v1::ErrorMapResponse* msg) {
-  msg->set_report_json(ErrorMapReportText(map, settings));
-  msg->set_verdict(VerdictName(map));
+                     const PlanOutcome& outcome, bool with_deviations, v1::ErrorMapResponse* msg) {
+  msg->set_report_json(ErrorMapReportText(map, settings, outcome));
+  msg->set_verdict(outcome.pass() ? "pass" : "fail");
+  OutcomeToProto(map, outcome, msg);
   if (with_deviations) msg->set_deviations(PackFloats(map.deviation_mm));
 }
 
@@ -290,8 +559,9 @@ void InspectionResultToProto(const std::string& part_id, const InspectionResult&
                              const ErrorMapSettings& settings, bool with_deviations,
                              v1::InspectResult* msg) {
   msg->set_part_id(part_id);
-  msg->set_verdict(VerdictName(result.error_map));
-  msg->set_report_json(ErrorMapReportText(result.error_map, settings));
+  msg->set_verdict(result.plan.pass() ? "pass" : "fail");
+  OutcomeToProto(result.error_map, result.plan, msg);
+  msg->set_report_json(ErrorMapReportText(result.error_map, settings, result.plan));
   msg->clear_views();
   for (const ViewOutcome& v : result.views) ViewOutcomeToProto(v, msg->add_views());
   if (with_deviations) {

@@ -96,12 +96,27 @@ void FilterResultToProto(const PointCloud& filtered, const LinkClusteringResult&
 // The merged cloud, its per-point view index (uint16) and grid index
 // (uint32), and the points per view. best_fit_correction is the caller's.
 void MergedCloudToProto(const MergedCloud& merged, v1::RegisterResponse* msg);
+// The plan message as a core InspectionPlan: unset tolerance_mm and
+// allowed_fraction_outside take `defaults` (+-tolerance_mm), like a JSON plan
+// without them. Shapes are checked here (3 numbers per position, one
+// selector per region), naming the field ("plan.regions[0].select"); the
+// values then go through ValidateInspectionPlan against the part mesh.
+absl::StatusOr<InspectionPlan> PlanFromProto(const v1::InspectionPlan& msg,
+                                             const ErrorMapSettings& defaults,
+                                             const std::string& field);
+void PlanToProto(const InspectionPlan& plan, v1::InspectionPlan* msg);
+// The typed results back as core structs (the clients' summaries).
+CharacteristicsResult CharacteristicsFromProto(
+    const google::protobuf::RepeatedPtrField<v1::CharacteristicResult>& list);
+DefectsResult DefectsFromProto(const google::protobuf::RepeatedPtrField<v1::DefectResult>& list);
 // "pass" or "fail", as in the JSON report.
 const char* VerdictName(const ErrorMapResult& map);
-// The report JSON text, the verdict and, when `with_deviations`, the
-// per-point deviations. The PNG is the caller's.
+// The report JSON text (surfinspect.report/2), the part verdict of
+// `outcome` (as "pass"/"fail" and as the enum), the typed statistics,
+// characteristics and defects, and, when `with_deviations`, the per-point
+// deviations. The PNG is the caller's.
 void ErrorMapToProto(const ErrorMapResult& map, const ErrorMapSettings& settings,
-                     bool with_deviations, v1::ErrorMapResponse* msg);
+                     const PlanOutcome& outcome, bool with_deviations, v1::ErrorMapResponse* msg);
 void ViewOutcomeToProto(const ViewOutcome& view, v1::ViewSummary* msg);
 // As ErrorMapToProto, plus the part id and the per-view summaries; with
 // `with_deviations` also the merged cloud (world frame) they belong to.

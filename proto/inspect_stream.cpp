@@ -50,6 +50,13 @@ absl::Status InspectStreamReader::ConsumePart(v1::PartHeader* header) {
   auto filter = FilterSettingsFromProto(header->filter(), "part.filter",
                                         LinkClusteringSettings::ForInspection());
   if (!filter.ok()) return filter.status();
+  // The plan's own values are checked here; against the mesh (triangle ids,
+  // groups) by InspectPart once the mesh is indexed.
+  if (header->has_plan()) {
+    auto plan = PlanFromProto(header->plan(), *error_map, "part.plan");
+    if (!plan.ok()) return plan.status();
+    part_.settings.plan = *std::move(plan);
+  }
   part_.id = header->part_id();
   part_.mesh.Swap(header->mutable_part());
   part_.world_from_part = *world_from_part;

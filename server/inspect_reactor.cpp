@@ -120,7 +120,7 @@ grpc::Status InspectReactor::RunInspection() {
                                 resp.mutable_result());
   if (part.return_png) {
     auto png = ErrorMapPngBytes(result->merged.cloud_in_world, part.world_from_part,
-                                result->error_map, index->mesh());
+                                result->error_map, index->mesh(), result->plan);
     if (!png.ok()) return ToGrpc(png.status());
     resp.mutable_result()->set_png(*std::move(png));
   }

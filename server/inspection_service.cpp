@@ -327,13 +327,20 @@ grpc::ServerUnaryReactor* InspectionService::ErrorMap(grpc::CallbackServerContex
     if (!world_from_part.ok()) return FromCore(world_from_part.status());
     auto settings = wire::ErrorMapSettingsFromProto(req->settings(), "settings");
     if (!settings.ok()) return FromCore(settings.status());
+    auto plan = req->has_plan() ? wire::PlanFromProto(req->plan(), *settings, "plan")
+                                : absl::StatusOr<InspectionPlan>(PlanFromSettings(*settings));
+    if (!plan.ok()) return FromCore(plan.status());
     std::shared_ptr<const MeshIndex> part;
     if (grpc::Status st = ResolveMesh(ctx, req->part(), "part", &part); !st.ok()) return st;
+    if (auto st = ValidateInspectionPlan(*plan, part->mesh(), {}, "plan"); !st.ok())
+      return FromCore(st);
     auto map = ComputeErrorMap(*part, *cloud, *world_from_part, *settings, &cancel);
     if (!map.ok()) return FromCore(map.status());
-    wire::ErrorMapToProto(*map, *settings, req->return_deviations(), resp);
+    auto outcome = EvaluatePlan(*map, *cloud, part->mesh(), *plan, settings->threads);
+    if (!outcome.ok()) return FromCore(outcome.status());
+    wire::ErrorMapToProto(*map, *settings, *outcome, req->return_deviations(), resp);
     if (req->return_png()) {
-      auto png = ErrorMapPngBytes(*cloud, *world_from_part, *map, part->mesh());
+      auto png = ErrorMapPngBytes(*cloud, *world_from_part, *map, part->mesh(), *outcome);
       if (!png.ok()) return FromCore(png.status());
       resp->set_png(*std::move(png));
     }

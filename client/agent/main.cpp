@@ -23,6 +23,7 @@
 #include "core/io/io_mesh.h"
 #include "core/process/buffer_reuse.h"
 #include "core/process/quiet_consoles.h"
+#include "proto/convert.h"
 
 namespace surfinspect::client {
 namespace {
@@ -135,9 +136,14 @@ void PrintPart(const PartReport& r) {
   }
 }
 
-// Streams a part, showing its progress on a terminal.
-InspectFn InspectOver(RemoteClient& client, const TriangleMesh& part) {
-  return [&client, &part](const v1::PartHeader& header, const std::vector<ViewScan>& views) {
+// Streams a part with the cell's inspection plan, showing its progress on a
+// terminal.
+InspectFn InspectOver(RemoteClient& client, const TriangleMesh& part,
+                      const std::optional<InspectionPlan>& plan) {
+  return [&client, &part, &plan](const v1::PartHeader& part_header,
+                                 const std::vector<ViewScan>& views) {
+    v1::PartHeader header = part_header;
+    if (plan) wire::PlanToProto(*plan, header.mutable_plan());
     const bool tty = isatty(STDERR_FILENO);
     auto result = client.Inspect(header, part, views, [&](const v1::Progress& p) {
       if (tty)
@@ -163,9 +169,10 @@ int Run(const AgentArgs& a) {
     spdlog::info("simulated robot: {} parts dropped into {}", ids.size(), layout.inbox);
   }
   const TriangleMesh part = OrDie(ReadMesh(cell.part_mesh));
+  const std::optional<InspectionPlan> plan = OrDie(PlanOf(cell, part, cell.error_map));
   auto client = ConnectFor(a, cell);
   AgentHooks hooks;
-  hooks.inspect = InspectOver(*client, part);
+  hooks.inspect = InspectOver(*client, part, plan);
   hooks.on_retry = [](const std::string& id, const absl::Status& st, int calls, double) {
     spdlog::warn("{}: {} (attempt {}, retrying)", id, std::string(st.message()), calls);
   };

@@ -139,6 +139,19 @@ absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
       c.viewpoints.push_back(*std::move(vp));
     }
     if (auto st = ReadSettings(j, c); !st.ok()) return Bad(path, st.message());
+    if (j.contains("plan")) {
+      if (j["plan"].is_string()) {
+        c.plan_source = Resolve(path, j["plan"].get<std::string>());
+        auto plan = ReadPlanJson(c.plan_source);
+        if (!plan.ok()) return plan.status();
+        c.plan = *std::move(plan);
+      } else if (j["plan"].is_object()) {
+        c.plan_source = path;
+        c.plan = j["plan"];
+      } else {
+        return Bad(path, "plan must be a file name or an object");
+      }
+    }
     if (j.contains("server")) {
       const auto& s = j["server"];
       c.server.target = s.value("target", "");
@@ -154,6 +167,23 @@ absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
   if (auto st = ValidateLinkClusteringSettings(c.filter_settings); !st.ok())
     return Bad(path, st.message());
   return c;
+}
+
+absl::StatusOr<nlohmann::json> ReadPlanJson(const std::string& path) {
+  auto text = ReadFileToString(path, 16 << 20);
+  if (!text.ok()) return text.status();
+  nlohmann::json j = nlohmann::json::parse(*text, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return Bad(path, "plan: not a JSON object");
+  return j;
+}
+
+absl::StatusOr<std::optional<InspectionPlan>> PlanOf(const CellConfig& cell,
+                                                     const TriangleMesh& part,
+                                                     const ErrorMapSettings& settings) {
+  if (!cell.plan) return std::optional<InspectionPlan>();
+  auto plan = ParsePlanWithDefaults(*cell.plan, part, settings);
+  if (!plan.ok()) return Bad(cell.plan_source, plan.status().message());
+  return std::optional<InspectionPlan>(*std::move(plan));
 }
 
 InspectionSettings InspectionSettingsOf(const CellConfig& cell) {

@@ -8,6 +8,9 @@
 //                 gauge_scan, world_from_sensor (after calibration),
 //                 calibration (quality figures)
 //   tolerance_mm, error_map{...}, filter{...}   optional settings
+//   plan                                    optional inspection plan: a path
+//                                           ("plan.json") or an inline object
+//                                           (docs/inspection-plan.md)
 //   server{target, tls_ca, tls_cert, tls_key, token_file}   optional
 // Transforms are {"matrix": [[...]...]} (row-major, mm).
 #pragma once
@@ -46,13 +49,28 @@ struct CellConfig {
   bool filter = true;
   LinkClusteringSettings filter_settings = LinkClusteringSettings::ForInspection();
   CellServer server;
-  nlohmann::json raw;  // the whole file, kept for rewriting
+  // The inspection plan's JSON (read from its file when cell.json names
+  // one); parsed against the part mesh by PlanOf. Unset: no plan.
+  std::optional<nlohmann::json> plan;
+  std::string plan_source;  // the file it came from, for messages
+  nlohmann::json raw;       // the whole file, kept for rewriting
 };
 
 absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path);
 
 // The cell's filter and error-map settings as one InspectionSettings.
 InspectionSettings InspectionSettingsOf(const CellConfig& cell);
+
+// An inspection plan file (JSON object, at most 16 MB); the plan is parsed
+// against a mesh by ParsePlanWithDefaults.
+absl::StatusOr<nlohmann::json> ReadPlanJson(const std::string& path);
+
+// The cell's plan parsed against `part` with `settings` as its defaults
+// (core/pipeline/plan_evaluation.h), or unset when the cell has none.
+// InvalidArgument "<file>: plan.<field>: ..." for a bad plan.
+absl::StatusOr<std::optional<InspectionPlan>> PlanOf(const CellConfig& cell,
+                                                     const TriangleMesh& part,
+                                                     const ErrorMapSettings& settings);
 
 // Stores each calibrated viewpoint's world_from_sensor and quality (JSON)
 // into the file: the previous file is kept as cell.json.bak, the new one is

@@ -1,5 +1,7 @@
 #include "client/cell/demo_cell_files.h"
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <system_error>
@@ -82,6 +84,44 @@ absl::StatusOr<nlohmann::json> WritePart(const std::string& dir, const DemoCell&
   return nlohmann::json{{"part_id", part.part_id}, {"defects", defects}, {"scans", scans}};
 }
 
+// The highest vertex of the part at the station nearest x: the ridge's top.
+double RidgeTopZ(const TriangleMesh& part, double x) {
+  double best_dx = INFINITY, z = -INFINITY;
+  for (const Eigen::Vector3f& v : part.vertices) {
+    const double dx = std::abs(v.x() - x);
+    if (dx < best_dx - 1e-9) best_dx = dx, z = v.z();
+    if (std::abs(dx - best_dx) <= 1e-9) z = std::max(z, double{v.z()});
+  }
+  return z;
+}
+
+// plan.json (docs/inspection-plan.md): the top ridge, where the parts are
+// judged, as a region with a tighter band than the cell's +-0.3 mm; three
+// comparison points along it; defect detection with the threshold chosen
+// for the scans' noise (sigma 0.015 mm: 0.03 mm is ~7 sigma of the local
+// median). The surface keeps the cell's tolerance_mm.
+nlohmann::json PlanJson(const DemoCell& cell) {
+  const Bounds3 b = ComputeBounds(cell.part);
+  nlohmann::json points = nlohmann::json::array();
+  for (const auto& [name, x] : {std::pair<const char*, double>{"ridge-left", -100.0},
+                                {"ridge-centre", 0.0},
+                                {"ridge-right", 100.0}})
+    points.push_back({{"name", name},
+                      {"position_mm", {x, 0.0, RidgeTopZ(cell.part, x)}},
+                      {"normal", {0, 0, 1}},
+                      {"radius_mm", 3.0},
+                      {"tolerance_mm", {{"lower", -0.1}, {"upper", 0.1}}}});
+  return {
+      {"schema", "surfinspect.plan/1"},
+      {"regions",
+       {{{"name", "ridge"},
+         {"select", {{"box_mm", {{b.min.x(), -25.0, 50.0}, {b.max.x(), 25.0, b.max.z() + 10}}}}},
+         {"tolerance_mm", {{"lower", -0.15}, {"upper", 0.15}}},
+         {"allowed_fraction_outside", 0.001}}}},
+      {"points", points},
+      {"defects", {{"threshold_mm", 0.03}, {"min_area_mm2", 3.0}}}};
+}
+
 nlohmann::json CellJson(const DemoCell& cell, nlohmann::json views) {
   return {{"units", "mm"},
           {"part",
@@ -97,6 +137,7 @@ nlohmann::json CellJson(const DemoCell& cell, nlohmann::json views) {
           // Stamped sheet metal: +-0.3 mm, and 0.1% of the points may fall
           // outside (unfiltered speckle at shadow edges) before a part fails.
           {"tolerance_mm", 0.3},
+          {"plan", "plan.json"},
           {"error_map", {{"allowed_fraction_outside", 0.001}, {"max_distance_mm", 5.0}}}};
 }
 
@@ -116,6 +157,8 @@ absl::Status WriteDemoCell(const std::string& dir, const DemoCell& cell,
     if (!entry.ok()) return entry.status();
     parts.push_back(*std::move(entry));
   }
+  if (auto st = WriteStringAtomically(dir + "/plan.json", PlanJson(cell).dump(2) + "\n"); !st.ok())
+    return st;
   if (auto st = WriteStringAtomically(dir + "/cell.json",
                                       CellJson(cell, *std::move(views)).dump(2) + "\n");
       !st.ok())

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "core/errormap/error_map_output.h"
 #include "core/io/atomic_file.h"
 #include "proto/convert.h"
@@ -29,19 +30,38 @@ absl::Status FillFromReport(PartOutputs& o) {
 
 }  // namespace
 
+std::vector<std::string> FailedLines(const CharacteristicsResult& characteristics) {
+  std::vector<std::string> lines;
+  for (const CharacteristicResult& c : characteristics.characteristics)
+    if (!c.pass) lines.push_back(absl::StrCat(c.name, ": ", c.reason));
+  return lines;
+}
+
+std::vector<std::string> DefectLines(const DefectsResult& defects) {
+  std::vector<std::string> lines;
+  for (const Defect& d : defects.defects)
+    lines.push_back(absl::StrFormat(
+        "%d %s at (%.1f, %.1f, %.1f) mm: peak %+.3f mm, %.1f mm2, %zu points%s%s", d.id,
+        DefectKindName(d.kind), d.centroid_mm.x(), d.centroid_mm.y(), d.centroid_mm.z(), d.peak_mm,
+        d.area_mm2, d.points, d.region.empty() ? "" : ", in ", d.region));
+  return lines;
+}
+
 absl::StatusOr<PartOutputs> OutputsFromLocal(const std::string& part_id, const InspectionResult& r,
                                              const InspectionSettings& settings,
                                              const Eigen::Isometry3d& world_from_part,
                                              const TriangleMesh& part) {
   PartOutputs o;
   o.part_id = part_id;
-  o.verdict = r.error_map.verdict.pass ? "pass" : "fail";
-  o.report_json = ErrorMapReportText(r.error_map, settings.error_map);
-  auto png = ErrorMapPngBytes(r.merged.cloud_in_world, world_from_part, r.error_map, part);
+  o.verdict = r.plan.pass() ? "pass" : "fail";
+  o.report_json = ErrorMapReportText(r.error_map, settings.error_map, r.plan);
+  auto png = ErrorMapPngBytes(r.merged.cloud_in_world, world_from_part, r.error_map, part, r.plan);
   if (!png.ok()) return png.status();
   o.png = *std::move(png);
   o.merged_in_world = r.merged.cloud_in_world;
   o.deviation_mm = r.error_map.deviation_mm;
+  o.failed = FailedLines(r.plan.characteristics);
+  o.defects = DefectLines(r.plan.defects);
   if (auto st = FillFromReport(o); !st.ok()) return st;
   return o;
 }
@@ -49,7 +69,12 @@ absl::StatusOr<PartOutputs> OutputsFromLocal(const std::string& part_id, const I
 absl::StatusOr<PartOutputs> OutputsFromRemote(const v1::InspectResult& r) {
   PartOutputs o;
   o.part_id = r.part_id();
-  o.verdict = r.verdict();
+  // A server without the typed verdict (VERDICT_UNSPECIFIED) still sends the string.
+  o.verdict = r.part_verdict() == v1::VERDICT_UNSPECIFIED ? r.verdict()
+              : r.part_verdict() == v1::VERDICT_PASS      ? "pass"
+                                                          : "fail";
+  o.failed = FailedLines(wire::CharacteristicsFromProto(r.characteristics()));
+  o.defects = DefectLines(wire::DefectsFromProto(r.defects()));
   o.report_json = r.report_json();
   o.png = r.png();
   auto merged =
@@ -74,6 +99,7 @@ v1::PartHeader MakePartHeader(const std::string& part_id, const Eigen::Isometry3
   header.set_skip_filter(!settings.filter);
   header.set_return_deviations(true);
   header.set_return_png(true);
+  if (settings.plan) wire::PlanToProto(*settings.plan, header.mutable_plan());
   return header;
 }
 

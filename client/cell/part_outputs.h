@@ -24,7 +24,13 @@ struct PartOutputs {
   double tolerance_mm = 0, color_range_mm = 0;
   // For people: from the report.
   double min_mm = 0, max_mm = 0;
+  std::vector<std::string> failed;   // "name: reason" per failing characteristic
+  std::vector<std::string> defects;  // one line per defect found
 };
+
+// The lines of PartOutputs::failed and ::defects.
+std::vector<std::string> FailedLines(const CharacteristicsResult& characteristics);
+std::vector<std::string> DefectLines(const DefectsResult& defects);
 
 absl::StatusOr<PartOutputs> OutputsFromLocal(const std::string& part_id, const InspectionResult& r,
                                              const InspectionSettings& settings,

@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
+#include "client/cell/cell_config.h"
+#include "client/cell/part_outputs.h"
 #include "client/cli/commands.h"
 #include "client/cli/remote_args.h"
 #include "core/distance/mesh_index.h"
@@ -17,6 +19,7 @@
 #include "core/io/io_mesh.h"
 #include "core/io/io_point_cloud.h"
 #include "core/io/io_transform.h"
+#include "core/pipeline/plan_evaluation.h"
 #include "core/types/transform.h"
 #include "proto/convert.h"
 
@@ -24,7 +27,7 @@ namespace surfinspect::cli {
 namespace {
 
 struct ErrorMapArgs {
-  std::string cloud, mesh, world_from_part, out, csv, report, png;
+  std::string cloud, mesh, world_from_part, out, csv, report, png, plan;
   std::string frame = "part";
   std::string png_axis = "auto";
   ErrorMapSettings settings;
@@ -45,19 +48,22 @@ struct ErrorMapRun {
   ErrorMapResult result;
   nlohmann::json report;
   std::string png_bytes;
+  std::vector<std::string> failed, defects;  // for the summary
 };
 
 // The server computes; PLY/CSV are written here from its deviations, the
 // report and PNG are its bytes (so both paths write the same files, timing
 // aside).
 ErrorMapRun RemoteErrorMap(const ErrorMapArgs& a, const PointCloud& cloud_in_world,
-                           const Eigen::Isometry3d& world_from_part, const TriangleMesh& mesh) {
+                           const Eigen::Isometry3d& world_from_part, const TriangleMesh& mesh,
+                           const InspectionPlan& plan) {
   if (a.settings.split_components) throw CommandFailed("--split-components is in-process only");
   if (!a.png.empty() && a.png_axis != "auto") throw CommandFailed("--png-axis is in-process only");
   v1::ErrorMapRequest req;
   wire::CloudToProto(cloud_in_world, req.mutable_cloud());
   wire::TransformToProto(world_from_part, req.mutable_world_from_part());
   wire::ErrorMapSettingsToProto(a.settings, req.mutable_settings());
+  if (!a.plan.empty()) wire::PlanToProto(plan, req.mutable_plan());
   req.set_return_deviations(true);
   req.set_return_png(!a.png.empty());
   const v1::ErrorMapResponse resp = Take(Connect(a.remote)->ErrorMap(req, mesh));
@@ -70,12 +76,14 @@ ErrorMapRun RemoteErrorMap(const ErrorMapArgs& a, const PointCloud& cloud_in_wor
   run.result.tolerance_mm = Number(run.report["tolerance"], "band_mm");
   run.result.color_range_mm = Number(run.report, "color_range_mm");
   run.png_bytes = resp.png();
+  run.failed = client::FailedLines(wire::CharacteristicsFromProto(resp.characteristics()));
+  run.defects = client::DefectLines(wire::DefectsFromProto(resp.defects()));
   return run;
 }
 
 ErrorMapRun LocalErrorMap(const ErrorMapArgs& a, const PointCloud& cloud_in_world,
                           const PointCloud& cloud_in_part, const Eigen::Isometry3d& world_from_part,
-                          TriangleMesh mesh, const MeshTopology& topo) {
+                          TriangleMesh mesh, const MeshTopology& topo, const InspectionPlan& plan) {
   const std::unique_ptr<MeshIndex> index = Take(MeshIndex::Build(std::move(mesh)));
   spdlog::info("mesh index built in {:.3f} s ({} boundary edges, {} degenerate triangles)",
                index->info().build_seconds, topo.boundary_edges,
@@ -84,9 +92,15 @@ ErrorMapRun LocalErrorMap(const ErrorMapArgs& a, const PointCloud& cloud_in_worl
   run.result = Take(ComputeErrorMap(*index, cloud_in_world, world_from_part, a.settings));
   spdlog::info("distances for {} points in {:.3f} s", run.result.stats.count,
                run.result.query_seconds);
-  run.report = ErrorMapReportJson(run.result, a.settings);
+  const PlanOutcome outcome =
+      Take(EvaluatePlan(run.result, cloud_in_world, index->mesh(), plan, a.settings.threads));
+  run.report = InspectionReportJson(run.result, a.settings, outcome);
+  run.failed = client::FailedLines(outcome.characteristics);
+  run.defects = client::DefectLines(outcome.defects);
   if (!a.png.empty()) {
     ErrorMapPngOptions png;
+    png.defects = &outcome.defects.defects;
+    png.part_pass = outcome.pass();
     png.view_axis = a.png_axis == "x" ? 0 : a.png_axis == "y" ? 1 : a.png_axis == "z" ? 2 : -1;
     run.png_bytes = Take(EncodePng(
         Take(RenderErrorMap(cloud_in_part, run.result, ComputeBounds(index->mesh()), png))));
@@ -94,7 +108,8 @@ ErrorMapRun LocalErrorMap(const ErrorMapArgs& a, const PointCloud& cloud_in_worl
   return run;
 }
 
-void PrintSummary(const ErrorMapArgs& a, const nlohmann::json& j) {
+void PrintSummary(const ErrorMapArgs& a, const ErrorMapRun& run) {
+  const nlohmann::json& j = run.report;
   const nlohmann::json& st = j["statistics"];
   const nlohmann::json& pts = j["points"];
   std::printf("points: %zu (valid %zu, matched %zu within %g mm)\n",
@@ -107,6 +122,13 @@ void PrintSummary(const ErrorMapArgs& a, const nlohmann::json& j) {
               Number(st, "p1_mm"), Number(st, "p5_mm"), Number(st, "p50_mm"), Number(st, "p95_mm"),
               Number(st, "p99_mm"));
   std::printf("verdict: %s\n", j["tolerance"].value("reason", std::string("?")).c_str());
+  if (!a.plan.empty()) {
+    std::printf("part: %s (%zu characteristics, %zu defects)\n",
+                j.value("verdict", std::string("?")).c_str(), j["characteristics"].size(),
+                j["defects"].size());
+    for (const std::string& line : run.failed) std::printf("  failed %s\n", line.c_str());
+    for (const std::string& line : run.defects) std::printf("  defect %s\n", line.c_str());
+  }
   std::printf("wrote %s%s%s%s%s%s%s\n", a.out.c_str(), a.csv.empty() ? "" : ", ", a.csv.c_str(),
               a.report.empty() ? "" : ", ", a.report.c_str(), a.png.empty() ? "" : ", ",
               a.png.c_str());
@@ -118,7 +140,13 @@ void RunErrorMap(const ErrorMapArgs& a) {
   const Eigen::Isometry3d world_from_part = a.world_from_part.empty()
                                                 ? Eigen::Isometry3d::Identity()
                                                 : Take(ReadTransformJson(a.world_from_part));
+  const nlohmann::json plan_json =
+      a.plan.empty() ? nlohmann::json() : Take(client::ReadPlanJson(a.plan));
   auto mesh = Take(ReadMesh(a.mesh));
+  // A bad plan is refused before anything is measured.
+  const InspectionPlan plan = a.plan.empty()
+                                  ? PlanFromSettings(a.settings)
+                                  : Take(ParsePlanWithDefaults(plan_json, mesh, a.settings));
   spdlog::info("read {} points and {} triangles in {:.3f} s", cloud_in_world.size(),
                mesh.num_triangles(), Seconds(t0));
   const MeshTopology topo = AnalyzeTopology(mesh);
@@ -127,9 +155,10 @@ void RunErrorMap(const ErrorMapArgs& a) {
                                     {"nonmanifold_edges", topo.nonmanifold_edges},
                                     {"degenerate_triangles", mesh.CountDegenerate()}};
   const PointCloud cloud_in_part = TransformCloud(cloud_in_world, world_from_part.inverse());
-  ErrorMapRun run = a.remote.remote() ? RemoteErrorMap(a, cloud_in_world, world_from_part, mesh)
-                                      : LocalErrorMap(a, cloud_in_world, cloud_in_part,
-                                                      world_from_part, std::move(mesh), topo);
+  ErrorMapRun run = a.remote.remote()
+                        ? RemoteErrorMap(a, cloud_in_world, world_from_part, mesh, plan)
+                        : LocalErrorMap(a, cloud_in_world, cloud_in_part, world_from_part,
+                                        std::move(mesh), topo, plan);
   // Files carry part-frame coordinates by default, so they overlay the CAD.
   const PointCloud& written = a.frame == "world" ? cloud_in_world : cloud_in_part;
   Check(WriteErrorMapPly(a.out, written, run.result, a.frame));
@@ -142,7 +171,7 @@ void RunErrorMap(const ErrorMapArgs& a) {
     run.report["output_frame"] = a.frame;
     Check(WriteStringAtomically(a.report, run.report.dump(2) + "\n"));
   }
-  PrintSummary(a, run.report);
+  PrintSummary(a, run);
 }
 
 }  // namespace
@@ -160,7 +189,10 @@ void AddErrorMapCommand(CLI::App& app) {
       ->required();
   cmd->add_option("--csv", a->csv, "CSV x,y,z,deviation, one row per input point");
   cmd->add_option("--report", a->report, "JSON report");
-  cmd->add_option("--png", a->png, "PNG: map, colour bar, histogram");
+  cmd->add_option("--png", a->png, "PNG: map, colour bar, histogram, defect ids");
+  cmd->add_option("--plan", a->plan,
+                  "inspection plan JSON: regions, comparison points, defect detection "
+                  "(docs/inspection-plan.md); its default band is +-tolerance");
   cmd->add_option("--tolerance", a->settings.tolerance_mm, "tolerance band +-MM")->default_val(0.1);
   cmd->add_option("--max-distance", a->settings.max_distance_mm,
                   "points farther from the CAD are unmatched (NaN), mm")

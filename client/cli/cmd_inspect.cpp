@@ -18,7 +18,7 @@ namespace surfinspect::cli {
 namespace {
 
 struct InspectArgs {
-  std::string cell, scans, out, part_id;
+  std::string cell, scans, out, part_id, plan;
   double tolerance = 0;
   RemoteArgs remote;
 };
@@ -29,6 +29,14 @@ void Inspect(const InspectArgs& a) {
   InspectionSettings settings = client::InspectionSettingsOf(cell);
   if (a.tolerance != 0) settings.error_map.tolerance_mm = a.tolerance;
   Check(ValidateErrorMapSettings(settings.error_map));
+  if (!a.plan.empty()) {
+    client::CellConfig with = cell;
+    with.plan = Take(client::ReadPlanJson(a.plan));
+    with.plan_source = a.plan;
+    settings.plan = Take(client::PlanOf(with, part, settings.error_map));
+  } else {
+    settings.plan = Take(client::PlanOf(cell, part, settings.error_map));
+  }
   std::vector<ViewScan> views;
   for (const auto& vp : cell.viewpoints) {
     const std::string path = a.scans + "/" + vp.name + ".pcd";
@@ -57,6 +65,8 @@ void Inspect(const InspectArgs& a) {
   Check(client::WritePartOutputs(a.out, outputs));
   std::printf("%s: %s  (min %.3f mm, max %.3f mm)  -> %s\n", part_id.c_str(),
               outputs.verdict.c_str(), outputs.min_mm, outputs.max_mm, a.out.c_str());
+  for (const std::string& line : outputs.failed) std::printf("  failed %s\n", line.c_str());
+  for (const std::string& line : outputs.defects) std::printf("  defect %s\n", line.c_str());
 }
 
 }  // namespace
@@ -72,6 +82,8 @@ void AddInspectCommand(CLI::App& app) {
       ->required();
   cmd->add_option("--part-id", a->part_id, "default: the scans folder's name");
   cmd->add_option("--tolerance", a->tolerance, "override the cell's tolerance, mm (0 = keep)");
+  cmd->add_option("--plan", a->plan,
+                  "inspection plan JSON (docs/inspection-plan.md); default: the cell's plan");
   AddRemoteOptions(cmd, a->remote);
   cmd->callback([a] { Inspect(*a); });
 }

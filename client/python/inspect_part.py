@@ -10,7 +10,6 @@ Prints "<part-id> pass|fail  min <mm> max <mm>" and exits 0 (pass), 1 (fail)
 or 2 (the part could not be inspected: bad input, or the call failed).
 """
 import argparse
-import json
 import os
 import sys
 import tempfile
@@ -66,13 +65,21 @@ def main():
     except grpc.RpcError as e:
         print(f"{part_id}: error: {e.code().name}: {e.details()}", file=sys.stderr)
         return 2
-    report = json.loads(result.report_json)
-    stats = report.get("statistics", {})
     if a.report:
         write_atomically(a.report, result.report_json)
-    print(f"{part_id} {result.verdict}  min {stats.get('min_mm', float('nan')):+.3f} mm"
-          f"  max {stats.get('max_mm', float('nan')):+.3f} mm")
-    return 0 if result.verdict == "pass" else 1
+    # The typed results: the part verdict, statistics, characteristics, defects.
+    verdict = "pass" if result.part_verdict == sc.pb.VERDICT_PASS else "fail"
+    print(f"{part_id} {verdict}  min {result.statistics.min_mm:+.3f} mm"
+          f"  max {result.statistics.max_mm:+.3f} mm")
+    for c in result.characteristics:
+        if c.verdict != sc.pb.VERDICT_PASS:
+            print(f"  failed {c.name}: {c.reason}")
+    for d in result.defects:
+        kind = "dent" if d.kind == sc.pb.DEFECT_DENT else "bump"
+        x, y, z = d.centroid_mm
+        print(f"  defect {d.id} {kind} at ({x:.1f}, {y:.1f}, {z:.1f}) mm: peak {d.peak_mm:+.3f} mm,"
+              f" {d.area_mm2:.1f} mm2")
+    return 0 if verdict == "pass" else 1
 
 
 if __name__ == "__main__":

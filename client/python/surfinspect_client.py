@@ -243,6 +243,7 @@ def read_cell(path):
             "tolerance_mm": j.get("tolerance_mm"),
             "error_map": j.get("error_map", {}),
             "filter": j.get("filter", {}),
+            "plan": _read_plan(base, j.get("plan")),
         }
     except (KeyError, TypeError) as e:
         raise ClientError(f"{path}: missing {e}") from None
@@ -253,6 +254,112 @@ def read_cell(path):
                                          for n, _ in cell["viewpoints"]):
         raise ClientError(f"{path}: viewpoints need non-empty names without '/'")
     return cell
+
+
+# ---- the inspection plan (docs/inspection-plan.md) ------------------------
+
+_PLAN_KEYS = {
+    "plan": {"schema", "tolerance_mm", "allowed_fraction_outside", "regions", "points", "defects"},
+    "region": {"name", "select", "tolerance_mm", "allowed_fraction_outside"},
+    "select": {"box_mm", "triangles", "group"},
+    "point": {"name", "position_mm", "normal", "radius_mm", "tolerance_mm"},
+    "defects": {"threshold_mm", "min_area_mm2", "max_count"},
+    "band": {"lower", "upper"},
+}
+
+
+def _read_plan(base, plan):
+    """cell.json's "plan": a file name (relative to cell.json), an inline
+    object, or absent (None)."""
+    if plan is None or isinstance(plan, dict):
+        return plan
+    if not isinstance(plan, str):
+        raise ClientError("cell.json: plan must be a file name or an object")
+    path = os.path.join(base, plan)
+    try:
+        with open(path) as f:
+            plan = json.load(f)
+    except (OSError, ValueError) as e:
+        raise ClientError(f"{path}: {e}") from None
+    if not isinstance(plan, dict):
+        raise ClientError(f"{path}: plan: not a JSON object")
+    return plan
+
+
+def _keys(obj, kind, where):
+    if not isinstance(obj, dict):
+        raise ClientError(f"{where}: must be an object")
+    for key in obj:
+        if key not in _PLAN_KEYS[kind]:
+            raise ClientError(f"{where}.{key}: unknown key")
+
+
+def _band(obj, msg, where):
+    _keys(obj, "band", where)
+    msg.lower_mm = _number(obj, "lower", where)
+    msg.upper_mm = _number(obj, "upper", where)
+
+
+def _vector3(values, where):
+    if not isinstance(values, list) or len(values) != 3:
+        raise ClientError(f"{where}: must be an array of 3 numbers")
+    return [_number({"v": v}, "v", where) for v in values]
+
+
+def plan_proto(plan):
+    """The JSON plan as the typed InspectionPlan message. Keys and shapes are
+    checked here, naming the field; the server checks the values against the
+    part mesh (INVALID_ARGUMENT "part.plan...")."""
+    msg = pb.InspectionPlan()
+    _keys(plan, "plan", "plan")
+    if "tolerance_mm" in plan:
+        _band(plan["tolerance_mm"], msg.tolerance_mm, "plan.tolerance_mm")
+    if "allowed_fraction_outside" in plan:
+        msg.allowed_fraction_outside = _number(plan, "allowed_fraction_outside", "plan")
+    for i, r in enumerate(plan.get("regions", [])):
+        where = f"plan.regions[{i}]"
+        _keys(r, "region", where)
+        m = msg.regions.add(name=str(r.get("name", "")))
+        s = r.get("select", {})
+        _keys(s, "select", where + ".select")
+        if "box_mm" in s:
+            box = s["box_mm"]
+            if not isinstance(box, list) or len(box) != 2:
+                raise ClientError(f"{where}.select.box_mm: must be [[x, y, z], [x, y, z]]")
+            m.select.box_mm.min_mm.extend(_vector3(box[0], where + ".select.box_mm[0]"))
+            m.select.box_mm.max_mm.extend(_vector3(box[1], where + ".select.box_mm[1]"))
+        elif "triangles" in s:
+            m.select.triangles.SetInParent()
+            for k, t in enumerate(s["triangles"]):
+                m.select.triangles.ids.append(
+                    _number({"t": t}, "t", f"{where}.select.triangles[{k}]", True, 0, 2**32 - 1))
+        elif "group" in s:
+            m.select.group = str(s["group"])
+        if "tolerance_mm" in r:
+            _band(r["tolerance_mm"], m.tolerance_mm, where + ".tolerance_mm")
+        if "allowed_fraction_outside" in r:
+            m.allowed_fraction_outside = _number(r, "allowed_fraction_outside", where)
+    for i, p in enumerate(plan.get("points", [])):
+        where = f"plan.points[{i}]"
+        _keys(p, "point", where)
+        m = msg.points.add(name=str(p.get("name", "")))
+        m.position_mm.extend(_vector3(p.get("position_mm"), where + ".position_mm"))
+        if "normal" in p:
+            m.normal.extend(_vector3(p["normal"], where + ".normal"))
+        if "radius_mm" in p:
+            m.radius_mm = _number(p, "radius_mm", where)
+        if "tolerance_mm" in p:
+            _band(p["tolerance_mm"], m.tolerance_mm, where + ".tolerance_mm")
+    if "defects" in plan:
+        d = plan["defects"]
+        _keys(d, "defects", "plan.defects")
+        msg.defects.SetInParent()
+        for key in ("threshold_mm", "min_area_mm2"):
+            if key in d:
+                setattr(msg.defects, key, _number(d, key, "plan.defects"))
+        if "max_count" in d:
+            msg.defects.max_count = _number(d, "max_count", "plan.defects", True, 0, 2**31 - 1)
+    return msg
 
 
 # ---- the call ------------------------------------------------------------
@@ -304,6 +411,8 @@ def _header(cell, part_id, mesh_ref):
     for key in ("min_cluster_points", "connectivity"):
         if key in f:
             setattr(h.filter, key, _number(f, key, "filter", True, 0, 2**32 - 1))
+    if cell.get("plan") is not None:
+        h.plan.CopyFrom(plan_proto(cell["plan"]))
     return h
 
 

@@ -20,13 +20,61 @@ Rgb Color(const ErrorMapResult& r, double d) {
   return DeviationColor(d, r.tolerance_mm, r.color_range_mm);
 }
 
+// Where each point lands on the map panel: the top-left corner of its
+// zoom x zoom block.
+struct MapLayout {
+  bool organized = false;
+  uint32_t width = 0, height = 0;  // in blocks
+  uint32_t zoom = 1;
+  uint32_t step = 1;           // organized: sensor pixels per block side
+  uint32_t cloud_width = 0;    // organized
+  int axis = 2, u = 0, v = 1;  // unorganized: view along -axis
+  Bounds3 bounds;              // unorganized
+  double pixel = 1;            // unorganized: mm per block
+  std::pair<uint32_t, uint32_t> BlockOf(std::size_t i, const Eigen::Vector3f& p) const {
+    if (organized)
+      return {static_cast<uint32_t>(i % cloud_width) / step,
+              static_cast<uint32_t>(i / cloud_width) / step};
+    return {static_cast<uint32_t>((p[u] - bounds.min[u]) / pixel),
+            height - 1 - static_cast<uint32_t>((p[v] - bounds.min[v]) / pixel)};
+  }
+};
+
+MapLayout GridLayout(const PointCloud& pts, uint32_t max_px) {
+  MapLayout l;
+  l.organized = true;
+  l.cloud_width = pts.width;
+  const uint32_t longest = std::max(pts.width, pts.height);
+  l.step = std::max<uint32_t>(1, (longest + max_px - 1) / max_px);
+  l.width = (pts.width + l.step - 1) / l.step;
+  l.height = (pts.height + l.step - 1) / l.step;
+  l.zoom = std::max<uint32_t>(1, kMinMapPixels / std::max(l.width, l.height));
+  return l;
+}
+
+// The pixel size follows the point density so a dense scan has no gaps.
+MapLayout OrthoLayout(const PointCloud& pts, int axis, uint32_t max_px) {
+  MapLayout l;
+  l.axis = axis;
+  l.u = (axis + 1) % 3;
+  l.v = (axis + 2) % 3;
+  l.bounds = ComputeBounds(pts);
+  if (l.bounds.empty()) return l;
+  const double eu = std::max(l.bounds.max[l.u] - l.bounds.min[l.u], 1e-9);
+  const double ev = std::max(l.bounds.max[l.v] - l.bounds.min[l.v], 1e-9);
+  const double n = static_cast<double>(std::max<std::size_t>(1, pts.CountValid()));
+  l.pixel =
+      std::max({std::max(eu, ev) / max_px, std::sqrt(eu * ev / n), std::max(eu, ev) / 4000.0});
+  l.width = static_cast<uint32_t>(eu / l.pixel) + 1;
+  l.height = static_cast<uint32_t>(ev / l.pixel) + 1;
+  l.zoom = std::max<uint32_t>(1, kMinMapPixels / std::max(l.width, l.height));
+  return l;
+}
+
 // Organized: the sensor grid, block-averaged down (or enlarged by an integer
 // factor) to fit. A block with valid but unmatched points is grey.
-RgbImage GridMap(const PointCloud& pts, const ErrorMapResult& r, uint32_t max_px) {
-  const uint32_t longest = std::max(pts.width, pts.height);
-  const uint32_t step = std::max<uint32_t>(1, (longest + max_px - 1) / max_px);
-  const uint32_t w = (pts.width + step - 1) / step, h = (pts.height + step - 1) / step;
-  const uint32_t zoom = std::max<uint32_t>(1, kMinMapPixels / std::max(w, h));
+RgbImage GridMap(const PointCloud& pts, const ErrorMapResult& r, const MapLayout& l) {
+  const uint32_t step = l.step, w = l.width, h = l.height, zoom = l.zoom;
   RgbImage img(w * zoom, h * zoom, kWhite);
   for (uint32_t by = 0; by < h; ++by)
     for (uint32_t bx = 0; bx < w; ++bx) {
@@ -51,31 +99,48 @@ RgbImage GridMap(const PointCloud& pts, const ErrorMapResult& r, uint32_t max_px
 
 // Unorganized: orthographic along -axis, image right = u, up = v (a right-
 // handed u, v, axis triple), the point nearest the viewer wins each pixel.
-// The pixel size follows the point density so a dense scan has no gaps.
-RgbImage OrthoMap(const PointCloud& pts, const ErrorMapResult& r, int axis, uint32_t max_px) {
-  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-  const Bounds3 b = ComputeBounds(pts);
-  if (b.empty()) return RgbImage(kMinMapPixels, kMinMapPixels, kWhite);
-  const double eu = std::max(b.max[u] - b.min[u], 1e-9), ev = std::max(b.max[v] - b.min[v], 1e-9);
-  const double n = static_cast<double>(std::max<std::size_t>(1, pts.CountValid()));
-  const double pixel =
-      std::max({std::max(eu, ev) / max_px, std::sqrt(eu * ev / n), std::max(eu, ev) / 4000.0});
-  const auto w = static_cast<uint32_t>(eu / pixel) + 1, h = static_cast<uint32_t>(ev / pixel) + 1;
-  const uint32_t zoom = std::max<uint32_t>(1, kMinMapPixels / std::max(w, h));
+RgbImage OrthoMap(const PointCloud& pts, const ErrorMapResult& r, const MapLayout& l) {
+  if (l.bounds.empty()) return RgbImage(kMinMapPixels, kMinMapPixels, kWhite);
+  const uint32_t w = l.width, h = l.height, zoom = l.zoom;
   RgbImage img(w * zoom, h * zoom, kWhite);
   std::vector<float> depth(std::size_t{w} * h, -INFINITY);
   for (std::size_t i = 0; i < pts.size(); ++i) {
     const Eigen::Vector3f& p = pts.points[i];
     if (!PointCloud::IsValid(p)) continue;
-    const auto x = static_cast<uint32_t>((p[u] - b.min[u]) / pixel);
-    const auto y = h - 1 - static_cast<uint32_t>((p[v] - b.min[v]) / pixel);
+    const auto [x, y] = l.BlockOf(i, p);
     float& z = depth[std::size_t{y} * w + x];
-    if (p[axis] <= z) continue;
-    z = p[axis];
+    if (p[l.axis] <= z) continue;
+    z = p[l.axis];
     img.FillRect(static_cast<int>(x * zoom), static_cast<int>(y * zoom), static_cast<int>(zoom),
                  static_cast<int>(zoom), Color(r, r.deviation_mm[i]));
   }
   return img;
+}
+
+// Each defect: a black square ring (radius 7 px) around the block of the
+// valid point nearest its centroid, and its id beside it.
+void DrawDefects(RgbImage& map, const PointCloud& pts, const MapLayout& l,
+                 const std::vector<Defect>& defects) {
+  for (const Defect& d : defects) {
+    const Eigen::Vector3f c = d.centroid_mm.cast<float>();
+    std::size_t best = pts.size();
+    float best_d2 = INFINITY;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      if (!PointCloud::IsValid(pts.points[i])) continue;
+      const float d2 = (pts.points[i] - c).squaredNorm();
+      if (d2 < best_d2) best_d2 = d2, best = i;
+    }
+    if (best == pts.size()) continue;
+    const auto [bx, by] = l.BlockOf(best, pts.points[best]);
+    const int x = static_cast<int>(bx * l.zoom + l.zoom / 2);
+    const int y = static_cast<int>(by * l.zoom + l.zoom / 2);
+    constexpr int kR = 7;
+    map.FillRect(x - kR, y - kR, 2 * kR + 1, 2, kBlack);
+    map.FillRect(x - kR, y + kR - 1, 2 * kR + 1, 2, kBlack);
+    map.FillRect(x - kR, y - kR, 2, 2 * kR + 1, kBlack);
+    map.FillRect(x + kR - 1, y - kR, 2, 2 * kR + 1, kBlack);
+    map.DrawText(x + kR + 3, y - kR, absl::StrCat(d.id), kBlack, 2);
+  }
 }
 
 std::string Label(double v, double range) {
@@ -85,9 +150,9 @@ std::string Label(double v, double range) {
 
 // Verdict text, colour bar with labels, and the histogram on the same
 // vertical deviation axis, drawn at x0.
-void DrawPanel(RgbImage& img, int x0, const ErrorMapResult& r) {
+void DrawPanel(RgbImage& img, int x0, const ErrorMapResult& r, bool pass) {
   const Verdict& v = r.verdict;
-  img.DrawText(x0 + 10, 10, v.pass ? "pass" : "fail", v.pass ? Rgb{0, 140, 0} : Rgb{200, 0, 0}, 3);
+  img.DrawText(x0 + 10, 10, pass ? "pass" : "fail", pass ? Rgb{0, 140, 0} : Rgb{200, 0, 0}, 3);
   const double range = r.color_range_mm;
   img.DrawText(x0 + 10, 40, absl::StrCat("tol +-", Label(r.tolerance_mm, range).substr(1), " mm"),
                kBlack, 2);
@@ -156,11 +221,15 @@ absl::StatusOr<RgbImage> RenderErrorMap(const PointCloud& points, const ErrorMap
   if (!(result.color_range_mm > 0))
     return absl::InvalidArgumentError("error map png: the result has no colour range");
   const int axis = options.view_axis >= 0 ? options.view_axis : ThinnestAxis(mesh_bounds);
-  const RgbImage map = points.organized() ? GridMap(points, result, options.max_map_pixels)
-                                          : OrthoMap(points, result, axis, options.max_map_pixels);
+  const MapLayout layout = points.organized() ? GridLayout(points, options.max_map_pixels)
+                                              : OrthoLayout(points, axis, options.max_map_pixels);
+  RgbImage map =
+      points.organized() ? GridMap(points, result, layout) : OrthoMap(points, result, layout);
+  if (options.defects) DrawDefects(map, points, layout, *options.defects);
   RgbImage img(map.width + kPanelWidth, std::max<uint32_t>(map.height, kMinHeight), kWhite);
   for (uint32_t y = 0; y < map.height; ++y) std::copy_n(&map.at(0, y), map.width, &img.at(0, y));
-  DrawPanel(img, static_cast<int>(map.width), result);
+  DrawPanel(img, static_cast<int>(map.width), result,
+            options.part_pass.value_or(result.verdict.pass));
   return img;
 }
 

@@ -3,12 +3,16 @@
 // same deviation axis, and the verdict. An organized cloud is drawn in its
 // sensor grid; a merged (unorganized) cloud as an orthographic view along an
 // axis, by default the CAD's thinnest extent (a sheet-metal part seen from
-// above), nearest point per pixel.
+// above), nearest point per pixel. Defects, when given, are marked on the map
+// by a ring at the drawn point nearest their centroid and their id.
 #pragma once
 
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
+#include "core/errormap/defects.h"
 #include "core/errormap/error_map.h"
 #include "core/io/png_image.h"
 #include "core/types/point_cloud.h"
@@ -19,7 +23,11 @@ struct ErrorMapPngOptions {
   // Unorganized clouds: look along -axis (0 = x, 1 = y, 2 = z), i.e. from
   // the + side; -1 = the thinnest extent of `mesh_bounds`.
   int view_axis = -1;
-  uint32_t max_map_pixels = 1000;  // longest side of the map panel
+  uint32_t max_map_pixels = 1000;                // longest side of the map panel
+  const std::vector<Defect>* defects = nullptr;  // marked with their ids when given
+  // The verdict written above the panel: the part's when given (an
+  // inspection plan's), else the error map's +-tolerance verdict.
+  std::optional<bool> part_pass;
 };
 
 // Index of the smallest extent of `b` (0, 1 or 2); 2 for empty bounds.

@@ -44,20 +44,30 @@ absl::StatusOr<InspectionResult> InspectPart(const MeshIndex& part,
       ComputeErrorMap(part, out.merged.cloud_in_world, world_from_part, settings.error_map, cancel);
   if (!map.ok()) return map.status();
   out.error_map = *std::move(map);
+  auto outcome = EvaluatePlan(out.error_map, out.merged.cloud_in_world, part.mesh(),
+                              settings.plan ? *settings.plan : PlanFromSettings(settings.error_map),
+                              settings.error_map.threads);
+  if (!outcome.ok()) return outcome.status();
+  out.plan = *std::move(outcome);
   if (progress) progress(InspectionStage::kErrorMap, "", out.error_map.stats.matched);
   return out;
 }
 
-std::string ErrorMapReportText(const ErrorMapResult& result, const ErrorMapSettings& settings) {
-  return ErrorMapReportJson(result, settings).dump(2) + "\n";
+std::string ErrorMapReportText(const ErrorMapResult& result, const ErrorMapSettings& settings,
+                               const PlanOutcome& outcome) {
+  return InspectionReportJson(result, settings, outcome).dump(2) + "\n";
 }
 
 absl::StatusOr<std::string> ErrorMapPngBytes(const PointCloud& cloud_in_world,
                                              const Eigen::Isometry3d& world_from_part,
                                              const ErrorMapResult& result,
-                                             const TriangleMesh& part_in_part) {
+                                             const TriangleMesh& part_in_part,
+                                             const PlanOutcome& outcome) {
   const PointCloud in_part = TransformCloud(cloud_in_world, world_from_part.inverse());
-  auto image = RenderErrorMap(in_part, result, ComputeBounds(part_in_part));
+  ErrorMapPngOptions options;
+  options.defects = &outcome.defects.defects;
+  options.part_pass = outcome.pass();
+  auto image = RenderErrorMap(in_part, result, ComputeBounds(part_in_part), options);
   if (!image.ok()) return image.status();
   return EncodePng(*image);
 }

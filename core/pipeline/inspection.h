@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,7 @@
 #include "core/distance/mesh_index.h"
 #include "core/errormap/error_map.h"
 #include "core/filter/link_clustering.h"
+#include "core/pipeline/plan_evaluation.h"
 #include "core/registration/registration.h"
 
 namespace surfinspect {
@@ -26,6 +28,8 @@ struct InspectionSettings {
   // strips that the size criterion removes (link_clustering.h).
   LinkClusteringSettings filter_settings = LinkClusteringSettings::ForInspection();
   ErrorMapSettings error_map;
+  // What the part is judged on; unset: PlanFromSettings(error_map).
+  std::optional<InspectionPlan> plan;
 };
 
 enum class InspectionStage { kViewFiltered, kViewRegistered, kErrorMap };
@@ -39,6 +43,7 @@ struct ViewOutcome {
 struct InspectionResult {
   MergedCloud merged;        // world frame; traces back to view + pixel
   ErrorMapResult error_map;  // per merged point
+  PlanOutcome plan;          // characteristics, defects and the part verdict
   std::vector<ViewOutcome> views;
 };
 
@@ -54,12 +59,15 @@ absl::StatusOr<InspectionResult> InspectPart(const MeshIndex& part_in_part,
                                              const std::atomic<bool>* cancel = nullptr);
 
 // The error-map outputs that travel as bytes (the RPCs and the CLI write the
-// very same bytes): the JSON report text, and the PNG drawn in the part
-// frame (sensor grid for an organized cloud, orthographic view otherwise).
-std::string ErrorMapReportText(const ErrorMapResult& result, const ErrorMapSettings& settings);
+// very same bytes): the JSON report text (InspectionReportJson), and the PNG
+// drawn in the part frame (sensor grid for an organized cloud, orthographic
+// view otherwise) with the outcome's defects marked by their ids.
+std::string ErrorMapReportText(const ErrorMapResult& result, const ErrorMapSettings& settings,
+                               const PlanOutcome& outcome);
 absl::StatusOr<std::string> ErrorMapPngBytes(const PointCloud& cloud_in_world,
                                              const Eigen::Isometry3d& world_from_part,
                                              const ErrorMapResult& result,
-                                             const TriangleMesh& part_in_part);
+                                             const TriangleMesh& part_in_part,
+                                             const PlanOutcome& outcome);
 
 }  // namespace surfinspect

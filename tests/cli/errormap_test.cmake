@@ -50,3 +50,49 @@ endif()
 if(EXISTS ${WORK}/x.ply)
   message(FATAL_ERROR "a failed run must not leave an output file")
 endif()
+# An inspection plan: a region over the whole plane with a wide band and a
+# comparison point on the -0.2 mm point; the report holds their results.
+file(WRITE ${WORK}/plan.json "{\"regions\": [{\"name\": \"all\", \"select\": {\"box_mm\": [[-1, -1, -1], [11, 11, 1]]}, \"tolerance_mm\": {\"lower\": -0.3, \"upper\": 0.6}}], \"points\": [{\"name\": \"P\", \"position_mm\": [5, 5, 0], \"radius_mm\": 1.0, \"tolerance_mm\": {\"lower\": -0.25, \"upper\": 0.1}}]}")
+execute_process(COMMAND ${CLI} ${ARGS} --plan ${WORK}/plan.json RESULT_VARIABLE rc OUTPUT_VARIABLE out
+                ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "part: fail \\(3 characteristics, 0 defects\\)"
+   OR NOT out MATCHES "failed surface: fail")
+  message(FATAL_ERROR "errormap --plan failed: ${rc}\n${out}\n${err}")
+endif()
+file(READ ${WORK}/o.json report)
+string(JSON schema GET "${report}" schema)
+string(JSON verdict GET "${report}" verdict)
+string(JSON n LENGTH "${report}" characteristics)
+string(JSON rname GET "${report}" characteristics 1 name)
+string(JSON region_verdict GET "${report}" characteristics 1 verdict)
+string(JSON pname GET "${report}" characteristics 2 name)
+string(JSON point_type GET "${report}" characteristics 2 type)
+string(JSON point_verdict GET "${report}" characteristics 2 verdict)
+string(JSON point_value GET "${report}" characteristics 2 value_mm)
+string(JSON point_n GET "${report}" characteristics 2 points)
+string(JSON defects LENGTH "${report}" defects)
+string(JSON band GET "${report}" tolerance band_mm)
+if(NOT schema STREQUAL "surfinspect.report/2" OR NOT verdict STREQUAL "fail" OR NOT n EQUAL 3
+   OR NOT rname STREQUAL "all" OR NOT region_verdict STREQUAL "pass" OR NOT pname STREQUAL "P"
+   OR NOT point_type STREQUAL "point" OR NOT point_verdict STREQUAL "pass" OR NOT point_n EQUAL 1
+   OR NOT point_value MATCHES "^-0\\.2" OR NOT defects EQUAL 0 OR NOT band EQUAL 0.1)
+  message(FATAL_ERROR "report/2 lacks the plan's characteristics:\n${report}")
+endif()
+# Bad plans are refused with the field named, before any output is written.
+file(REMOVE ${WORK}/x.ply)
+file(WRITE ${WORK}/bad1.json "{\"regions\": [{\"name\": \"r\", \"select\": {\"box_mm\": [[5, 0, 0], [1, 1, 1]]}}]}")
+file(WRITE ${WORK}/bad2.json "{\"points\": [{\"name\": \"P\", \"position_mm\": [1, 1, 0], \"tolerance_mm\": {\"lower\": 0.2, \"upper\": 0.1}}]}")
+file(WRITE ${WORK}/bad3.json "{\"tolerance\": 0.1}")
+file(WRITE ${WORK}/bad4.json "{\"regions\": [{\"name\": \"r\", \"select\": {\"triangles\": [0, 2]}}]}")
+foreach(bad "bad1.json|plan.regions\\[0\\].select.box_mm" "bad2.json|plan.points\\[0\\].tolerance_mm"
+            "bad3.json|plan.tolerance: unknown key" "bad4.json|plan.regions\\[0\\].select.triangles\\[1\\]")
+  string(REPLACE "|" ";" pair "${bad}")
+  list(GET pair 0 file)
+  list(GET pair 1 want)
+  execute_process(COMMAND ${CLI} errormap --cloud ${WORK}/c.pcd --mesh ${WORK}/plane.off
+                          --out ${WORK}/x.ply --plan ${WORK}/${file}
+                  RESULT_VARIABLE rc ERROR_VARIABLE err)
+  if(rc EQUAL 0 OR NOT err MATCHES "${want}" OR EXISTS ${WORK}/x.ply)
+    message(FATAL_ERROR "${file} must be refused naming ${want}: ${rc}\n${err}")
+  endif()
+endforeach()

@@ -62,6 +62,11 @@ def main():
                           "--world-from-part", "wfp.json", "--out", "{d}/e.ply", "--csv", "{d}/e.csv",
                           "--png", "{d}/e.png", "--report", "{d}/e.json", "--tolerance", "0.3"],
                          ["e.ply", "e.csv", "e.png"], ["e.json"]),
+            # The demo cell's plan (regions, points, defects) travels typed.
+            "errormap --plan": (["surfinspect", "errormap", "--cloud", "{d}/merged.ply", "--mesh", "cell/part.stl",
+                                 "--world-from-part", "wfp.json", "--out", "{d}/p.ply", "--png", "{d}/p.png",
+                                 "--report", "{d}/p.json", "--tolerance", "0.3", "--plan", "cell/plan.json"],
+                                ["p.ply", "p.png"], ["p.json"]),
         }
         failures = []
         for mode in ("local", "remote"):

@@ -6,6 +6,8 @@
 #include <cstring>
 #include <string>
 
+#include "core/errormap/plan_report.h"
+
 namespace surfinspect::wire {
 namespace {
 
@@ -150,15 +152,22 @@ ErrorMapResult SmallMap(bool pass) {
   return map;
 }
 
+// The part verdict of a plan outcome.
+PlanOutcome Outcome(bool pass) {
+  PlanOutcome o;
+  o.characteristics.pass = pass;
+  return o;
+}
+
 TEST(ErrorMapToProto, ReportVerdictAndDeviationsOnlyWhenAsked) {
   const ErrorMapSettings settings;
   v1::ErrorMapResponse with;
-  ErrorMapToProto(SmallMap(true), settings, true, &with);
+  ErrorMapToProto(SmallMap(true), settings, Outcome(true), true, &with);
   EXPECT_EQ(with.verdict(), "pass");
-  EXPECT_EQ(with.report_json(), ErrorMapReportText(SmallMap(true), settings));
+  EXPECT_EQ(with.report_json(), ErrorMapReportText(SmallMap(true), settings, Outcome(true)));
   EXPECT_EQ(with.deviations(), PackFloats(SmallMap(true).deviation_mm));
   v1::ErrorMapResponse without;
-  ErrorMapToProto(SmallMap(false), settings, false, &without);
+  ErrorMapToProto(SmallMap(false), settings, Outcome(false), false, &without);
   EXPECT_EQ(without.verdict(), "fail");
   EXPECT_TRUE(without.deviations().empty());
   EXPECT_TRUE(without.png().empty()) << "the caller's";
@@ -169,13 +178,14 @@ TEST(InspectionResultToProto, PartIdVerdictReportViewsAndOptionalDeviations) {
   r.error_map = SmallMap(false);
   r.merged.cloud_in_world = PointCloud::Unorganized({{1, 2, 3}, {4, 5, 6}, {7, 8, 9}});
   r.views = {{"top", 1200, 7}, {"side", 800, 0}};
+  r.plan = Outcome(false);
   ErrorMapSettings settings;
   settings.tolerance_mm = 0.25;
   v1::InspectResult msg;
   InspectionResultToProto("part-7", r, settings, true, &msg);
   EXPECT_EQ(msg.part_id(), "part-7");
   EXPECT_EQ(msg.verdict(), "fail");
-  EXPECT_EQ(msg.report_json(), ErrorMapReportText(r.error_map, settings));
+  EXPECT_EQ(msg.report_json(), ErrorMapReportText(r.error_map, settings, r.plan));
   ASSERT_EQ(msg.views_size(), 2);
   EXPECT_EQ(msg.views(0).name(), "top");
   EXPECT_EQ(msg.views(0).valid_points(), 1200u);
@@ -217,6 +227,102 @@ TEST(MeshFromProto, AnEmptyMeshIsRefusedBeforeAnyCopy) {
   msg.mutable_triangles()->assign(12, '\0');  // a triangle, no vertices
   EXPECT_EQ(MeshFromProto(msg, "part.inline", limits).status().code(),
             absl::StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace surfinspect::wire
+
+namespace surfinspect::wire {
+namespace {
+
+TEST(PlanProto, RoundTripsEveryFieldAndUnsetBandsTakeTheSettings) {
+  InspectionPlan plan;
+  plan.tolerance = {-0.05, 0.15};
+  plan.allowed_fraction_outside = 0.01;
+  PlanRegion box{"box", {}, ToleranceBand{-0.2, 0.1}, 0.5};
+  box.select.box_min_mm = {-1, -2, -3};
+  box.select.box_max_mm = {4, 5, 6};
+  PlanRegion tris{"tris", {}, {}, 0};
+  tris.select.kind = RegionSelector::Kind::kTriangles;
+  tris.select.triangles = {0, 7, 3};
+  PlanRegion group{"group", {}, {}, 0};
+  group.select.kind = RegionSelector::Kind::kGroup;
+  group.select.group = "flange";
+  plan.regions = {box, tris, group};
+  plan.points = {{"P1", {1, 2, 3}, {0, 0, 1}, 2.5, ToleranceBand{-0.1, 0.3}},
+                 {"P2", {4, 5, 6}, {}, 2.0, {}}};
+  plan.defects = DefectRules{0.03, 4.0, 2};
+  v1::InspectionPlan msg;
+  PlanToProto(plan, &msg);
+  auto back = PlanFromProto(msg, {}, "plan");
+  ASSERT_TRUE(back.ok()) << back.status();
+  v1::InspectionPlan again;
+  PlanToProto(*back, &again);
+  EXPECT_EQ(msg.SerializeAsString(), again.SerializeAsString());
+  EXPECT_EQ(back->regions[1].select.triangles, tris.select.triangles);
+  EXPECT_EQ(back->regions[2].select.group, "flange");
+  EXPECT_FALSE(back->points[1].tolerance.has_value());
+  EXPECT_EQ(*back->defects->max_count, 2);
+  EXPECT_EQ(back->tolerance.upper_mm, 0.15);
+  // An empty message: the surface against +-tolerance_mm, no defects.
+  ErrorMapSettings s;
+  s.tolerance_mm = 0.3;
+  s.allowed_fraction_outside = 0.001;
+  auto empty = PlanFromProto(v1::InspectionPlan{}, s, "plan");
+  ASSERT_TRUE(empty.ok());
+  EXPECT_EQ(empty->tolerance.lower_mm, -0.3);
+  EXPECT_EQ(empty->tolerance.upper_mm, 0.3);
+  EXPECT_EQ(empty->allowed_fraction_outside, 0.001);
+  EXPECT_FALSE(empty->defects.has_value());
+}
+
+TEST(PlanProto, ShapesAreCheckedNamingTheField) {
+  v1::InspectionPlan msg;
+  msg.add_regions()->set_name("r");
+  EXPECT_EQ(PlanFromProto(msg, {}, "part.plan").status().message(),
+            "part.plan.regions[0].select: needs exactly one selector (box_mm, triangles, group)");
+  msg.Clear();
+  v1::ComparisonPoint* p = msg.add_points();
+  p->add_position_mm(1);
+  EXPECT_EQ(PlanFromProto(msg, {}, "plan").status().message(),
+            "plan.points[0].position_mm: must be 3 numbers");
+  for (double v : {1.0, 2.0}) p->add_position_mm(v);
+  for (double v : {0.0, 0.0, 0.0}) p->add_normal(v);
+  EXPECT_EQ(PlanFromProto(msg, {}, "plan").status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+TEST(OutcomeProto, TypedResultsAndBackToCore) {
+  PlanOutcome o;
+  CharacteristicResult c;
+  c.name = "ridge";
+  c.type = CharacteristicType::kRegion;
+  c.pass = false;
+  c.reason = "fail: 3% outside";
+  c.tolerance = {-0.15, 0.15};
+  c.points = 10;
+  c.mean_mm = 0.01;
+  o.characteristics.characteristics = {c};
+  Defect d;
+  d.id = 1;
+  d.kind = DefectKind::kBump;
+  d.centroid_mm = {1, 2, 3};
+  d.peak_mm = 0.2;
+  d.region = "ridge";
+  o.defects.defects = {d};
+  v1::ErrorMapResponse msg;
+  ErrorMapToProto(SmallMap(true), {}, o, false, &msg);
+  EXPECT_EQ(msg.part_verdict(), v1::VERDICT_FAIL);
+  EXPECT_EQ(msg.verdict(), "fail");
+  EXPECT_EQ(msg.statistics().tolerance_verdict(), v1::VERDICT_PASS);
+  EXPECT_EQ(msg.statistics().matched(), 2u);
+  ASSERT_EQ(msg.characteristics_size(), 1);
+  EXPECT_EQ(msg.characteristics(0).type(), v1::CHARACTERISTIC_REGION);
+  EXPECT_TRUE(std::isnan(msg.characteristics(0).value_mm()));
+  EXPECT_EQ(msg.defects(0).kind(), v1::DEFECT_BUMP);
+  const CharacteristicsResult back = CharacteristicsFromProto(msg.characteristics());
+  EXPECT_EQ(CharacteristicsJson(back), CharacteristicsJson(o.characteristics));
+  EXPECT_EQ(back.failed, 1u);
+  EXPECT_EQ(DefectsJson(DefectsFromProto(msg.defects())), DefectsJson(o.defects));
 }
 
 }  // namespace

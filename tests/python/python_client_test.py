@@ -137,9 +137,13 @@ class PythonClientTest(unittest.TestCase):
         py.pop("timing", None)
         cpp.pop("timing", None)
         self.assertEqual(py, cpp)
-        verdict = cpp["tolerance"]["verdict"]
+        # The exit code and the first line are the part verdict (the typed field).
+        verdict = cpp["verdict"]
         self.assertEqual(r.returncode, 0 if verdict == "pass" else 1)
-        self.assertRegex(r.stdout, rf"^part-001 {verdict}  min [-+]\d+\.\d{{3}} mm  max [-+]\d+\.\d{{3}} mm$")
+        failed = [c["name"] for c in cpp["characteristics"] if c["verdict"] != "pass"]
+        self.assertEqual(re.findall(r"^  failed ([^:]+):", r.stdout, re.M), failed)
+        self.assertEqual(len(re.findall(r"^  defect ", r.stdout, re.M)), len(cpp["defects"]))
+        self.assertRegex(r.stdout, rf"(?m)^part-001 {verdict}  min [-+]\d+\.\d{{3}} mm  max [-+]\d+\.\d{{3}} mm$")
         self.assertIn(f"{cpp['statistics']['max_mm']:+.3f}", r.stdout)
 
     def test_hash_miss_falls_back_to_inline(self):

@@ -78,6 +78,115 @@ v1::ErrorMapRequest ErrorMapRequest(const PointCloud& cloud) {
   return req;
 }
 
+// A typed number equals the report's, NaN standing for its null.
+void ExpectSame(double typed, const nlohmann::json& j, const std::string& what) {
+  if (j.is_null())
+    EXPECT_TRUE(std::isnan(typed)) << what;
+  else
+    EXPECT_EQ(typed, j.get<double>()) << what;
+}
+
+// The typed results of an ErrorMapResponse or InspectResult equal its report_json.
+template <typename Msg>
+void ExpectTypedEqualsJson(const Msg& m) {
+  const nlohmann::json j = nlohmann::json::parse(m.report_json());
+  EXPECT_EQ(m.part_verdict() == v1::VERDICT_PASS ? "pass" : "fail", j["verdict"]);
+  EXPECT_EQ(m.verdict(), j["verdict"]);
+  const v1::ErrorMapStatistics& s = m.statistics();
+  EXPECT_EQ(s.count(), j["points"]["count"]);
+  EXPECT_EQ(s.matched(), j["points"]["matched"]);
+  for (const auto& [name, v] : {std::pair<const char*, double>{"min_mm", s.min_mm()},
+                                {"max_mm", s.max_mm()},
+                                {"mean_mm", s.mean_mm()},
+                                {"rms_mm", s.rms_mm()},
+                                {"p50_mm", s.p50_mm()},
+                                {"p99_mm", s.p99_mm()}})
+    ExpectSame(v, j["statistics"][name], name);
+  EXPECT_EQ(s.within(), j["tolerance"]["within"]);
+  EXPECT_EQ(s.tolerance_verdict() == v1::VERDICT_PASS ? "pass" : "fail", j["tolerance"]["verdict"]);
+  ASSERT_EQ(static_cast<std::size_t>(m.characteristics_size()), j["characteristics"].size());
+  for (int i = 0; i < m.characteristics_size(); ++i) {
+    const v1::CharacteristicResult& c = m.characteristics(i);
+    const nlohmann::json& cj = j["characteristics"][i];
+    EXPECT_EQ(c.name(), cj["name"]);
+    EXPECT_EQ(c.verdict() == v1::VERDICT_PASS ? "pass" : "fail", cj["verdict"]) << c.name();
+    EXPECT_EQ(c.reason(), cj["reason"]);
+    EXPECT_EQ(c.points(), cj["points"]);
+    EXPECT_EQ(c.tolerance_mm().lower_mm(), cj["tolerance_mm"]["lower"]);
+    EXPECT_EQ(c.tolerance_mm().upper_mm(), cj["tolerance_mm"]["upper"]);
+    ExpectSame(c.mean_mm(), cj["mean_mm"], c.name() + " mean");
+    ExpectSame(c.min_mm(), cj["min_mm"], c.name() + " min");
+    ExpectSame(c.fraction_within(), cj["fraction_within"], c.name() + " fraction");
+    if (cj.contains("value_mm")) ExpectSame(c.value_mm(), cj["value_mm"], c.name() + " value");
+  }
+  ASSERT_EQ(static_cast<std::size_t>(m.defects_size()), j["defects"].size());
+  for (int i = 0; i < m.defects_size(); ++i) {
+    const v1::DefectResult& d = m.defects(i);
+    const nlohmann::json& dj = j["defects"][i];
+    EXPECT_EQ(d.id(), dj["id"]);
+    EXPECT_EQ(d.kind() == v1::DEFECT_DENT ? "dent" : "bump", dj["kind"]);
+    EXPECT_EQ(d.peak_mm(), dj["peak_mm"]);
+    EXPECT_EQ(d.area_mm2(), dj["area_mm2"]);
+    EXPECT_EQ(d.points(), dj["points"]);
+    EXPECT_EQ(d.region(), dj["region"]);
+    ASSERT_EQ(d.centroid_mm_size(), 3);
+    for (int a = 0; a < 3; ++a) EXPECT_EQ(d.centroid_mm(a), dj["centroid_mm"][a]);
+  }
+}
+
+// A plan on the demo part: the ridge, two comparison points, defects on.
+InspectionPlan DemoPlan() {
+  auto plan = ParsePlanWithDefaults(nlohmann::json::parse(R"({
+    "regions": [{"name": "ridge", "select": {"box_mm": [[-150, -25, 50], [150, 25, 70]]},
+                 "tolerance_mm": {"lower": -0.15, "upper": 0.15}}],
+    "points": [{"name": "centre", "position_mm": [0, 0, 60], "radius_mm": 3},
+               {"name": "nowhere", "position_mm": [0, 0, 500]}],
+    "defects": {"threshold_mm": 0.03, "min_area_mm2": 3.0}})"),
+                                    TestData().cell.part, {});
+  EXPECT_TRUE(plan.ok()) << plan.status();
+  return *plan;
+}
+
+TEST(InspectionService, ThePlanTravelsTypedAndTheResultsAreTypedToo) {
+  testing::ServerProcess server;
+  ASSERT_TRUE(server.started());
+  auto client = ClientFor(server);
+  const Data& d = TestData();
+  const InspectionPlan plan = DemoPlan();
+  v1::ErrorMapRequest req = ErrorMapRequest(d.merged_world);
+  wire::PlanToProto(plan, req.mutable_plan());
+  auto eresp = client->ErrorMap(req, d.cell.part);
+  ASSERT_TRUE(eresp.ok()) << eresp.status();
+  ExpectTypedEqualsJson(*eresp);
+  // The same report as in-process with the same plan.
+  auto part_index = *MeshIndex::Build(d.cell.part);
+  const ErrorMapResult map =
+      *ComputeErrorMap(*part_index, d.merged_world, d.cell.world_from_part, {});
+  const PlanOutcome outcome = *EvaluatePlan(map, d.merged_world, d.cell.part, plan);
+  nlohmann::json remote = nlohmann::json::parse(eresp->report_json());
+  nlohmann::json local = InspectionReportJson(map, {}, outcome);
+  remote.erase("timing");
+  local.erase("timing");
+  EXPECT_EQ(remote, local);
+  EXPECT_EQ(remote["characteristics"].size(), 4u);
+  EXPECT_EQ(eresp->characteristics(3).reason().substr(0, 16), "fail: unmeasured");
+
+  // Inspect: the plan in the part header.
+  v1::PartHeader header;
+  header.set_part_id("planned");
+  wire::TransformToProto(d.cell.world_from_part, header.mutable_world_from_part());
+  wire::PlanToProto(plan, header.mutable_plan());
+  auto iresp = client->Inspect(header, d.cell.part, d.views, {});
+  ASSERT_TRUE(iresp.ok()) << iresp.status();
+  ExpectTypedEqualsJson(*iresp);
+  InspectionSettings settings;
+  settings.plan = plan;
+  const InspectionResult r = *InspectPart(*part_index, d.cell.world_from_part, d.views, settings);
+  EXPECT_EQ(iresp->characteristics_size(), 4);
+  EXPECT_EQ(iresp->defects_size(), static_cast<int>(r.plan.defects.defects.size()));
+  EXPECT_EQ(iresp->part_verdict() == v1::VERDICT_PASS, r.plan.pass());
+}
+
 TEST(InspectionService, EveryRpcMatchesInProcess) {
   testing::ServerProcess server;
   ASSERT_TRUE(server.started());
@@ -142,10 +251,14 @@ TEST(InspectionService, EveryRpcMatchesInProcess) {
     differing += std::memcmp(&remote_dev[i], &local_map.deviation_mm[i], 4) != 0;
   EXPECT_EQ(differing, 0u);
   nlohmann::json remote_report = nlohmann::json::parse(eresp->report_json());
-  nlohmann::json local_report = nlohmann::json::parse(ErrorMapReportText(local_map, {}));
+  const PlanOutcome local_outcome =
+      *EvaluatePlan(local_map, d.merged_world, d.cell.part, PlanFromSettings({}));
+  nlohmann::json local_report =
+      nlohmann::json::parse(ErrorMapReportText(local_map, {}, local_outcome));
   remote_report.erase("timing");
   local_report.erase("timing");
   EXPECT_EQ(remote_report, local_report);
+  ExpectTypedEqualsJson(*eresp);
 
   // Inspect (stream): same verdict and deviations as InspectPart.
   v1::PartHeader header;
@@ -317,6 +430,37 @@ TEST(InspectionService, BadRequestsGetTheRightCodeAndTheServerStaysUp) {
   for (const auto& [name, c] : cases) {
     EXPECT_EQ(c.first.error_code(), c.second) << name << ": " << c.first.error_message();
     EXPECT_FALSE(c.first.error_message().empty()) << name;
+  }
+
+  // Bad plans: INVALID_ARGUMENT naming the field, in ErrorMap and Inspect.
+  std::vector<std::pair<grpc::Status, std::string>> plans;
+  v1::ErrorMapRequest inverted = em;
+  v1::Box* box = inverted.mutable_plan()->add_regions()->mutable_select()->mutable_box_mm();
+  inverted.mutable_plan()->mutable_regions(0)->set_name("r");
+  for (double v : {5.0, 0.0, 0.0}) box->add_min_mm(v);
+  for (double v : {1.0, 1.0, 1.0}) box->add_max_mm(v);
+  plans.push_back({errormap(inverted), "plan.regions[0].select.box_mm"});
+  v1::ErrorMapRequest out_of_range = em;
+  v1::PlanRegion* tri = out_of_range.mutable_plan()->add_regions();
+  tri->set_name("t");
+  tri->mutable_select()->mutable_triangles()->add_ids(d.cell.part.num_triangles());
+  plans.push_back({errormap(out_of_range), "plan.regions[0].select.triangles[0]"});
+  v1::ErrorMapRequest band = em;
+  v1::ComparisonPoint* p = band.mutable_plan()->add_points();
+  p->set_name("p");
+  for (double v : {0.0, 0.0, 60.0}) p->add_position_mm(v);
+  p->mutable_tolerance_mm()->set_lower_mm(0.2);
+  p->mutable_tolerance_mm()->set_upper_mm(0.1);
+  plans.push_back({errormap(band), "plan.points[0].tolerance_mm"});
+  v1::ErrorMapRequest short_position = em;
+  short_position.mutable_plan()->add_points()->set_name("q");
+  plans.push_back({errormap(short_position), "plan.points[0].position_mm"});
+  v1::InspectRequest no_selector = part_msg;
+  no_selector.mutable_part()->mutable_plan()->add_regions()->set_name("r");
+  plans.push_back({raw.Inspect({no_selector}), "part.plan.regions[0].select"});
+  for (const auto& [st, field] : plans) {
+    EXPECT_EQ(st.error_code(), StatusCode::INVALID_ARGUMENT) << field << ": " << st.error_message();
+    EXPECT_NE(st.error_message().find(field), std::string::npos) << st.error_message();
   }
   auto client = ClientFor(server);
   EXPECT_EQ(*client->Health(), "SERVING");

@@ -450,6 +450,55 @@ TEST(ErrorMapOutput, PngOfAnOrganizedScanIsTheSensorGridWithPanel) {
   EXPECT_FALSE(RenderErrorMap(f.cloud, r, ComputeBounds(f.index->mesh()), bad).ok());
 }
 
+TEST(ErrorMapOutput, DefectsAreMarkedWithTheirIdsAtTheirPixel) {
+  const ScanFixture f = SmallOrganizedScan();
+  const std::size_t i = 15 * 40 + 25;  // row 15, col 25 of the 40 x 30 grid
+  ASSERT_TRUE(PointCloud::IsValid(f.cloud.points[i]));
+  std::vector<Defect> defects(1);
+  defects[0].id = 7;
+  defects[0].centroid_mm = f.cloud.points[i].cast<double>() + Eigen::Vector3d(0.01, 0, 0);
+  ErrorMapPngOptions with;
+  with.defects = &defects;
+  const Bounds3 b = ComputeBounds(f.index->mesh());
+  auto plain = RenderErrorMap(f.cloud, f.result, b);
+  auto marked = RenderErrorMap(f.cloud, f.result, b, with);
+  ASSERT_TRUE(plain.ok() && marked.ok());
+  ASSERT_EQ(plain->width, marked->width);
+  // The block of point i is (250..259, 150..159); the ring has radius 7
+  // around its centre (255, 155), the id is drawn right of it.
+  const Rgb black{0, 0, 0};
+  EXPECT_EQ(marked->at(248, 155), black);
+  EXPECT_EQ(marked->at(262, 155), black);
+  EXPECT_EQ(marked->at(255, 148), black);
+  EXPECT_EQ(marked->at(255, 155), plain->at(255, 155)) << "the ring leaves the value visible";
+  std::size_t changed = 0;
+  for (uint32_t y = 0; y < plain->height; ++y)
+    for (uint32_t x = 0; x < plain->width; ++x) {
+      if (plain->at(x, y) == marked->at(x, y)) continue;
+      ++changed;
+      EXPECT_TRUE(x >= 248 && x <= 280 && y >= 148 && y <= 162) << x << "," << y;
+    }
+  EXPECT_GT(changed, 60u) << "ring and the digit 7";
+  std::vector<Defect> none;
+  with.defects = &none;
+  EXPECT_TRUE(RenderErrorMap(f.cloud, f.result, b, with)->pixels == plain->pixels);
+  // The part verdict replaces the tolerance verdict ("fail" here) in the panel.
+  ASSERT_FALSE(f.result.verdict.pass);
+  with.part_pass = false;
+  EXPECT_TRUE(RenderErrorMap(f.cloud, f.result, b, with)->pixels == plain->pixels);
+  with.part_pass = true;
+  auto passed = RenderErrorMap(f.cloud, f.result, b, with);
+  auto green = [](const RgbImage& img) {
+    std::size_t n = 0;
+    for (uint32_t y = 0; y < 35; ++y)
+      for (uint32_t x = 400; x < img.width; ++x) n += img.at(x, y) == Rgb{0, 140, 0} ? 1 : 0;
+    return n;
+  };
+  EXPECT_GT(green(*passed), 50u) << "a green 'pass' at the panel's top";
+  EXPECT_EQ(green(*plain), 0u);
+  EXPECT_FALSE(passed->pixels == plain->pixels);
+}
+
 TEST(ErrorMapOutput, PngOfAMergedCloudLooksAlongTheThinnestAxis) {
   const ScanFixture f = SmallOrganizedScan();
   const PointCloud merged = PointCloud::Unorganized(f.cloud.points);  // same points, no grid

@@ -12,10 +12,10 @@
 
 #include "core/errormap/error_map_output.h"
 #include "core/errormap/error_map_png.h"
-#include "tests/support/png_decode.h"
 #include "core/simulation/demo_cell.h"
 #include "core/simulation/scan_simulator.h"
 #include "core/types/transform.h"
+#include "tests/support/png_decode.h"
 
 namespace surfinspect {
 namespace {
@@ -310,21 +310,20 @@ TEST_F(Inspection, NoViewsOrABadPoseIsInvalidArgument) {
 TEST_F(Inspection, ReportTextIsTheErrorMapJsonIndentedWithANewline) {
   ASSERT_TRUE(result_);
   const ErrorMapSettings es = settings().error_map;
-  const std::string text = ErrorMapReportText(result_->error_map, es);
+  const std::string text = ErrorMapReportText(result_->error_map, es, result_->plan);
   ASSERT_FALSE(text.empty());
   EXPECT_EQ(text.back(), '\n');
   EXPECT_EQ(text.substr(0, 5), "{\n  \"") << "two-space indentation";
   const nlohmann::json parsed = nlohmann::json::parse(text);
-  EXPECT_EQ(parsed, ErrorMapReportJson(result_->error_map, es));
+  EXPECT_EQ(parsed, InspectionReportJson(result_->error_map, es, result_->plan));
   EXPECT_EQ(parsed["points"]["matched"], result_->error_map.stats.matched);
   EXPECT_EQ(parsed["tolerance"]["verdict"], "fail");
 }
 
-
 TEST_F(Inspection, PngBytesAreTheMapDrawnInThePartFrame) {
   ASSERT_TRUE(result_);
   auto bytes = ErrorMapPngBytes(result_->merged.cloud_in_world, cell_->world_from_part,
-                                result_->error_map, cell_->part);
+                                result_->error_map, cell_->part, result_->plan);
   ASSERT_TRUE(bytes.ok()) << bytes.status();
   const RgbImage decoded = testing::DecodePng(*bytes);
   ASSERT_GT(decoded.width, 0u);
@@ -334,7 +333,10 @@ TEST_F(Inspection, PngBytesAreTheMapDrawnInThePartFrame) {
   for (const auto& p : result_->merged.cloud_in_world.points)
     in_part.points.push_back((part_from_world * p.cast<double>()).cast<float>());
   in_part.width = static_cast<uint32_t>(in_part.points.size());
-  auto expected = RenderErrorMap(in_part, result_->error_map, ComputeBounds(cell_->part));
+  ErrorMapPngOptions options;
+  options.defects = &result_->plan.defects.defects;
+  options.part_pass = result_->plan.pass();
+  auto expected = RenderErrorMap(in_part, result_->error_map, ComputeBounds(cell_->part), options);
   ASSERT_TRUE(expected.ok()) << expected.status();
   EXPECT_EQ(decoded.width, expected->width);
   EXPECT_EQ(decoded.height, expected->height);

@@ -1,0 +1,60 @@
+#include "core/pipeline/plan_evaluation.h"
+
+#include "core/errormap/error_map_output.h"
+#include "core/errormap/plan_report.h"
+
+namespace surfinspect {
+
+InspectionPlan PlanFromSettings(const ErrorMapSettings& settings) {
+  InspectionPlan plan;
+  plan.tolerance = {-settings.tolerance_mm, settings.tolerance_mm};
+  plan.allowed_fraction_outside = settings.allowed_fraction_outside;
+  return plan;
+}
+
+absl::StatusOr<InspectionPlan> ParsePlanWithDefaults(const nlohmann::json& json,
+                                                     const TriangleMesh& part,
+                                                     const ErrorMapSettings& settings,
+                                                     const std::string& where) {
+  if (!json.is_object()) return absl::InvalidArgumentError(where + ": must be an object");
+  nlohmann::json with = json;
+  if (!with.contains("tolerance_mm"))
+    with["tolerance_mm"] = {{"lower", -settings.tolerance_mm}, {"upper", settings.tolerance_mm}};
+  if (!with.contains("allowed_fraction_outside"))
+    with["allowed_fraction_outside"] = settings.allowed_fraction_outside;
+  return ParseInspectionPlan(with, part, where);
+}
+
+absl::StatusOr<PlanOutcome> EvaluatePlan(const ErrorMapResult& error_map, const PointCloud& cloud,
+                                         const TriangleMesh& part, const InspectionPlan& plan,
+                                         int threads) {
+  auto resolved = ResolveInspectionPlan(plan, part);
+  if (!resolved.ok()) return resolved.status();
+  PlanOutcome out;
+  if (plan.defects) {
+    DefectSettings ds;
+    ds.threads = threads;
+    auto found = FindDefects(error_map, cloud, part, *plan.defects, &*resolved, ds);
+    if (!found.ok()) return found.status();
+    out.defects = *std::move(found);
+    out.defects_run = true;
+  }
+  CharacteristicsSettings cs;
+  cs.threads = threads;
+  auto judged = ComputeCharacteristics(error_map, *resolved, out.defects.defects.size(), cs);
+  if (!judged.ok()) return judged.status();
+  out.characteristics = *std::move(judged);
+  return out;
+}
+
+nlohmann::json InspectionReportJson(const ErrorMapResult& error_map,
+                                    const ErrorMapSettings& settings, const PlanOutcome& outcome) {
+  nlohmann::json j = ErrorMapReportJson(error_map, settings);
+  j["schema"] = kReportSchema;
+  j["verdict"] = outcome.pass() ? "pass" : "fail";
+  j["characteristics"] = CharacteristicsJson(outcome.characteristics);
+  j["defects"] = DefectsJson(outcome.defects);
+  return j;
+}
+
+}  // namespace surfinspect

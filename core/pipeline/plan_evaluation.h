@@ -1,0 +1,63 @@
+// The error map judged against an inspection plan, for every caller (the
+// CLI's errormap and inspect, the ErrorMap and Inspect RPCs, the cell-agent):
+// the plan is resolved on the part mesh, defects are found when the plan
+// asks for them (core/errormap/defects.h), and every characteristic and the
+// part verdict are computed (core/errormap/characteristics.h). The report
+// text that goes into report.json ("schema": "surfinspect.report/2") is built
+// here too, so every caller writes the same bytes.
+//
+// Without a plan a part is judged by PlanFromSettings: the whole surface
+// against the error map's +-tolerance_mm and allowed_fraction_outside, so the
+// part verdict is the tolerance verdict. Units mm, part frame.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "core/errormap/characteristics.h"
+#include "core/errormap/defects.h"
+#include "core/errormap/error_map.h"
+#include "core/errormap/inspection_plan.h"
+#include "core/types/point_cloud.h"
+#include "core/types/triangle_mesh.h"
+
+namespace surfinspect {
+
+inline constexpr char kReportSchema[] = "surfinspect.report/2";
+
+// The plan of a caller without one: the surface only, band {-t, +t} and the
+// settings' allowed_fraction_outside.
+InspectionPlan PlanFromSettings(const ErrorMapSettings& settings);
+
+// ParseInspectionPlan with the error-map settings as defaults: a plan
+// without "tolerance_mm" takes {-t, +t} of settings.tolerance_mm, one without
+// "allowed_fraction_outside" takes the settings' (the symmetric --tolerance
+// is the shorthand of the plan's band).
+absl::StatusOr<InspectionPlan> ParsePlanWithDefaults(const nlohmann::json& json,
+                                                     const TriangleMesh& part,
+                                                     const ErrorMapSettings& settings,
+                                                     const std::string& where = "plan");
+
+struct PlanOutcome {
+  CharacteristicsResult characteristics;  // surface, regions, points
+  bool defects_run = false;               // the plan has defect rules
+  DefectsResult defects;                  // empty unless defects_run
+  bool pass() const { return characteristics.pass; }
+};
+
+// `cloud` is the cloud `error_map` was computed on (any frame), `part` the
+// mesh it was computed against. InvalidArgument (field named, "plan...")
+// for a plan that does not fit the part.
+absl::StatusOr<PlanOutcome> EvaluatePlan(const ErrorMapResult& error_map, const PointCloud& cloud,
+                                         const TriangleMesh& part, const InspectionPlan& plan,
+                                         int threads = 0);
+
+// report.json's object: the error map's report (settings, points,
+// statistics, tolerance, histogram, ...) plus "schema", "verdict" (the part
+// verdict), "characteristics" and "defects" (core/errormap/plan_report.h).
+nlohmann::json InspectionReportJson(const ErrorMapResult& error_map,
+                                    const ErrorMapSettings& settings, const PlanOutcome& outcome);
+
+}  // namespace surfinspect
