@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # outputs.sh BIN OUT: the demo cell, then filter, calibrate, register, errormap (PLY, CSV, PNG, JSON)
-# Used to check that a change keeps every output byte-identical: run it with the
-# binaries from before and after, then tests/compare/compare.sh BEFORE AFTER.
-# and inspect, in-process, all written under OUT. Compare two OUTs with compare.sh.
+# and inspect (in-process and through a surfinspectd it starts), all written under OUT.
+# A change keeps every output byte-identical when outputs.sh runs with the binaries from
+# before and after it and tests/compare/compare.sh BEFORE AFTER prints "identical".
 set -euo pipefail
 BIN=$(cd "$1" && pwd); OUT=$2; rm -rf "$OUT"; mkdir -p "$OUT"; cd "$OUT"
 si="$BIN/surfinspect"
