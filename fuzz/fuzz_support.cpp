@@ -22,9 +22,9 @@ bool RegisterTarget(const char* name, TargetFn fn) {
 
 std::string WriteScratchFile(std::string_view bytes, const std::string& extension) {
   // /dev/shm keeps the per-input write off the disk; fall back to the temp folder.
-  static const std::string folder =
-      std::filesystem::is_directory("/dev/shm") ? "/dev/shm"
-                                                : std::filesystem::temp_directory_path().string();
+  static const std::string folder = std::filesystem::is_directory("/dev/shm")
+                                        ? "/dev/shm"
+                                        : std::filesystem::temp_directory_path().string();
   const std::string path =
       folder + "/surfinspect-fuzz-" + std::to_string(::getpid()) + "." + extension;
   std::FILE* f = std::fopen(path.c_str(), "wb");

@@ -26,17 +26,17 @@ std::string WriteScratchFile(std::string_view bytes, const std::string& extensio
 }  // namespace surfinspect::fuzz
 
 #ifdef SURFINSPECT_LIBFUZZER
-#define SURFINSPECT_FUZZ_TARGET(name)                                                  \
+#define SURFINSPECT_FUZZ_TARGET(name)                                                 \
   static void FuzzOne_##name(std::string_view bytes);                                 \
   extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) { \
-    FuzzOne_##name(std::string_view(reinterpret_cast<const char*>(data), size));       \
-    return 0;                                                                          \
-  }                                                                                    \
+    FuzzOne_##name(std::string_view(reinterpret_cast<const char*>(data), size));      \
+    return 0;                                                                         \
+  }                                                                                   \
   static void FuzzOne_##name(std::string_view bytes)
 #else
-#define SURFINSPECT_FUZZ_TARGET(name)                                              \
-  static void FuzzOne_##name(std::string_view bytes);                             \
-  [[maybe_unused]] static const bool kRegistered_##name =                         \
-      ::surfinspect::fuzz::RegisterTarget(#name, &FuzzOne_##name);                \
+#define SURFINSPECT_FUZZ_TARGET(name)                              \
+  static void FuzzOne_##name(std::string_view bytes);              \
+  [[maybe_unused]] static const bool kRegistered_##name =          \
+      ::surfinspect::fuzz::RegisterTarget(#name, &FuzzOne_##name); \
   static void FuzzOne_##name(std::string_view bytes)
 #endif

@@ -37,8 +37,7 @@ std::vector<fs::path> FilesIn(const fs::path& folder) {
 }
 
 // Returns the number of failures for one target's folder.
-int ReplayTarget(const std::string& name, const fs::path& folder, double max_seconds,
-                 int* inputs) {
+int ReplayTarget(const std::string& name, const fs::path& folder, double max_seconds, int* inputs) {
   int failed = 0;
   for (const auto& file : FilesIn(folder)) {
     const std::string bytes = ReadAll(file);
@@ -64,9 +63,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path corpus = argv[1];
-  const double max_seconds = argc >= 4 && std::strcmp(argv[2], "--max-seconds") == 0
-                                 ? std::atof(argv[3])
-                                 : 5.0;
+  const double max_seconds =
+      argc >= 4 && std::strcmp(argv[2], "--max-seconds") == 0 ? std::atof(argv[3]) : 5.0;
   int inputs = 0, passed = 0, failed = 0;
   for (const auto& [name, fn] : Targets()) {
     const fs::path folder = corpus / name;

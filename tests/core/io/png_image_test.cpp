@@ -11,7 +11,6 @@
 namespace surfinspect {
 namespace {
 
-
 RgbImage Gradient(uint32_t w, uint32_t h) {
   RgbImage img(w, h);
   for (uint32_t y = 0; y < h; ++y)
