@@ -5,6 +5,8 @@
 #include <numeric>
 #include <unordered_map>
 
+#include "core/types/percentile.h"
+
 namespace surfinspect {
 namespace {
 
@@ -220,14 +222,7 @@ std::unique_ptr<SurfaceNeighbourhood> MakeCellNeighbourhood(const ErrorMapResult
   return std::make_unique<CellNeighbourhood>(em, cloud, radius_mm, link_mm);
 }
 
-double MedianInPlace(std::vector<double>& v) {
-  if (v.empty()) return NAN;
-  const std::size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
-  if (v.size() % 2) return v[mid];
-  return 0.5 *
-         (v[mid] + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid)));
-}
+double MedianInPlace(std::vector<double>& v) { return Percentiles<double>(v).At(0.5); }
 
 double EstimateSurfaceSpacing(const ErrorMapResult& em, const PointCloud& cloud) {
   const auto& p = cloud.points;

@@ -61,8 +61,9 @@ std::unique_ptr<SurfaceNeighbourhood> MakeCellNeighbourhood(const ErrorMapResult
 // sampling they are. 1 mm when nothing can be measured.
 double EstimateSurfaceSpacing(const ErrorMapResult& error_map, const PointCloud& cloud);
 
-// The median of v (the mean of the two middle values for an even count);
-// reorders v. NaN when v is empty.
+// The median of v: the report's one percentile definition at q = 0.5 (the
+// mean of the two middle values for an even count); reorders v. NaN when v
+// is empty.
 double MedianInPlace(std::vector<double>& v);
 
 }  // namespace surfinspect
