@@ -97,6 +97,7 @@ PartReport CellAgent::Steps(const std::string& id, const std::atomic<bool>& stop
   std::vector<ViewScan> views;
   PartReport ended;
   if (!ReadViews(id, &views, &ended)) return ended;
+  for (const auto& listener : hooks_.on_started) listener(id);
   return InspectAndStore(id, views, stop);
 }
 
@@ -110,7 +111,13 @@ PartReport CellAgent::QuarantinePart(const std::string& id, const std::string& w
   return Report(PartOutcome::kQuarantined, why);
 }
 
+void CellAgent::TellStored(const std::string& id) const {
+  const std::string dir = (fs::path(layout_.results) / id).string();
+  for (const auto& listener : hooks_.on_stored) listener(id, dir);
+}
+
 PartReport CellAgent::ArchiveWithoutCall(const std::string& id) {
+  TellStored(id);
   if (absl::Status st = MovePart(layout_.inbox, layout_.archive, id); !st.ok())
     return Report(PartOutcome::kRetryLater,
                   absl::StrCat("results already on disk; ", st.message()));
@@ -179,6 +186,7 @@ PartReport CellAgent::InspectAndStore(const std::string& id, const std::vector<V
       r.verdict = outputs->verdict;
       r.min_mm = outputs->min_mm;
       r.max_mm = outputs->max_mm;
+      TellStored(id);
       // The results are safe; the next pass archives it without a call.
       if (absl::Status st = MovePart(layout_.inbox, layout_.archive, id); !st.ok())
         r.message = std::string(st.message());

@@ -83,6 +83,14 @@ struct AgentHooks {
   SleepFn sleep = SleepUnlessStopped;  // backoff and poll waits
   // Called before each backoff wait with the part id, the failure, calls so far, the wait (s).
   std::function<void(const std::string&, const absl::Status&, int, double)> on_retry;
+  // Listeners (the results store, plant events) are told when a part's scans
+  // have been read and it is about to be sent, and when its results are on
+  // disk in RESULTS/<id>/, after an inspection or when a restart finds them
+  // there. They cannot fail a part: the files are the primary record, so a
+  // listener that cannot do its work catches up from them later.
+  std::vector<std::function<void(const std::string& part_id)>> on_started;
+  std::vector<std::function<void(const std::string& part_id, const std::string& results_dir)>>
+      on_stored;
 };
 
 class CellAgent {
@@ -107,6 +115,7 @@ class CellAgent {
   bool ReadViews(const std::string& id, std::vector<ViewScan>* views, PartReport* report);
   PartReport InspectAndStore(const std::string& id, const std::vector<ViewScan>& views,
                              const std::atomic<bool>& stop);
+  void TellStored(const std::string& id) const;
 
   const CellConfig& cell_;
   InboxLayout layout_;

@@ -161,6 +161,29 @@ TEST_F(AgentTest, PartWithResultsOnDiskIsArchivedWithoutACall) {
   EXPECT_EQ(ReadBytes((fs::path(layout_.results) / "p1" / "report.json").string()), "{}");
 }
 
+// Listeners hear of a part once its results are on disk, whether it was just
+// inspected or a restart found its results; never of a quarantined part.
+TEST_F(AgentTest, ListenersHearStartedAndStoredPartsOnly) {
+  std::vector<std::string> heard;
+  hooks_.on_started.push_back([&](const std::string& id) { heard.push_back("started " + id); });
+  hooks_.on_stored.push_back([&](const std::string& id, const std::string& dir) {
+    EXPECT_TRUE(fs::exists(fs::path(dir) / "report.json")) << dir;
+    heard.push_back("stored " + id);
+  });
+  answers_ = {absl::InvalidArgumentError("bad scan")};
+  DropPart("p0");
+  DropPart("p1");
+  DropPart("p2");
+  fs::create_directories(fs::path(layout_.results) / "p2");
+  WriteBytes((fs::path(layout_.results) / "p2" / "report.json").string(), "{}");
+  CellAgent agent = Agent();
+  EXPECT_EQ(agent.ProcessPart("p0", stop_).outcome, PartOutcome::kQuarantined);
+  EXPECT_EQ(agent.ProcessPart("p1", stop_).outcome, PartOutcome::kDone);
+  EXPECT_EQ(agent.ProcessPart("p2", stop_).outcome, PartOutcome::kArchivedWithoutCall);
+  EXPECT_EQ(heard,
+            (std::vector<std::string>{"started p0", "started p1", "stored p1", "stored p2"}));
+}
+
 TEST_F(AgentTest, ArchiveNameCollisionKeepsBothParts) {
   const fs::path earlier = fs::path(layout_.archive) / "p1";
   fs::create_directories(earlier);
