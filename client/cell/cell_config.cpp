@@ -1,5 +1,7 @@
 #include "client/cell/cell_config.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -110,6 +112,25 @@ absl::Status ReadSettings(const nlohmann::json& j, CellConfig& c) {
   return st;
 }
 
+// The cell's name from cell.json, or the name of the folder that holds it.
+absl::StatusOr<std::string> CellName(const std::string& path, const nlohmann::json& j) {
+  std::string name = j.contains("name")
+                         ? (j["name"].is_string() ? j["name"].get<std::string>() : std::string())
+                         : std::filesystem::absolute(std::filesystem::path(path))
+                               .parent_path()
+                               .filename()
+                               .string();
+  const bool ok =
+      !name.empty() && name.size() <= 64 && std::all_of(name.begin(), name.end(), [](char ch) {
+        return std::isalnum(static_cast<unsigned char>(ch)) || ch == '.' || ch == '_' || ch == '-';
+      });
+  if (!ok)
+    return Bad(path,
+               absl::StrCat("name \"", name.substr(0, 64),
+                            "\" must be 1-64 letters, digits, '.', '_' or '-' (set \"name\")"));
+  return name;
+}
+
 }  // namespace
 
 absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
@@ -121,6 +142,9 @@ absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
   if (c.raw.is_discarded() || !c.raw.is_object()) return Bad(path, "not a JSON object");
   const nlohmann::json& j = c.raw;
   try {
+    auto name = CellName(path, j);
+    if (!name.ok()) return name.status();
+    c.name = *std::move(name);
     if (!j.contains("part") || !j["part"].contains("mesh") ||
         !j["part"].contains("world_from_part"))
       return Bad(path, "needs part.mesh and part.world_from_part");

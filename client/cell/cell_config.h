@@ -2,6 +2,10 @@
 // are relative to the file's directory. Written by `surfinspect demo-cell`
 // (or by hand), completed by `cell-agent calibrate`, read by `cell-agent run`
 // and `surfinspect inspect`:
+//   name                                    optional; default: the folder's name.
+//                                           Letters, digits, '.', '_', '-': it
+//                                           names the cell in results, events
+//                                           and the results store
 //   part.mesh, part.world_from_part         CAD of the part and its pose
 //   gauge.mesh                              CAD of the calibration gauge
 //   viewpoints[]: name, nominal_world_from_sensor, world_from_gauge,
@@ -42,6 +46,7 @@ struct CellServer {
 
 struct CellConfig {
   std::string path;                   // of cell.json
+  std::string name;                   // the cell's name (see above)
   std::string part_mesh, gauge_mesh;  // resolved paths
   Eigen::Isometry3d world_from_part = Eigen::Isometry3d::Identity();
   std::vector<CellViewpoint> viewpoints;

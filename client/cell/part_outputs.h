@@ -4,6 +4,7 @@
 // written atomically (temporary file, then rename).
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,11 @@ struct PartOutputs {
   double min_mm = 0, max_mm = 0;
   std::vector<std::string> failed;   // "name: reason" per failing characteristic
   std::vector<std::string> defects;  // one line per defect found
+  // Context for the reports written beside report.json: the cell's name, the
+  // part's pose, and its CAD mesh in the part frame (null when not at hand).
+  std::string cell;
+  Eigen::Isometry3d world_from_part = Eigen::Isometry3d::Identity();
+  std::shared_ptr<const TriangleMesh> mesh_in_part;
 };
 
 // The lines of PartOutputs::failed and ::defects.

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <string>
 
 #include "tests/support/temp_dir.h"
@@ -40,6 +41,23 @@ TEST(CellConfig, ReadsTheSettingsBlocks) {
   EXPECT_FLOAT_EQ(c->filter_settings.link_distance_mm, 0.7f);
   EXPECT_EQ(c->filter_settings.min_cluster_points, 20u);
   EXPECT_EQ(c->filter_settings.connectivity, 4);
+}
+
+// The cell's name goes into results, topics and the store: it defaults to the
+// folder's name and is refused, by name, when it could break a path or topic.
+TEST(CellConfig, NameDefaultsToTheFolderAndIsCheckedForSafeCharacters) {
+  auto c = Read(Cell(R"(, "name": "press-line_2.cell")"));
+  ASSERT_TRUE(c.ok()) << c.status();
+  EXPECT_EQ(c->name, "press-line_2.cell");
+  auto d = Read(Cell(""));
+  ASSERT_TRUE(d.ok()) << d.status();
+  EXPECT_EQ(d->name, std::filesystem::path(d->path).parent_path().filename().string());
+  EXPECT_FALSE(d->name.empty());
+  for (const char* bad : {R"("a/b")", R"("plant/#")", R"("")", R"(7)", R"("x y")"}) {
+    auto e = Read(Cell(std::string(R"(, "name": )") + bad));
+    ASSERT_FALSE(e.ok()) << bad;
+    EXPECT_NE(std::string(e.status().message()).find("name"), std::string::npos) << e.status();
+  }
 }
 
 TEST(CellConfig, RefusesNumbersThatWouldWrapOrOverflowByName) {
