@@ -205,7 +205,7 @@ absl::StatusOr<std::optional<InspectionPlan>> PlanOf(const CellConfig& cell,
                                                      const TriangleMesh& part,
                                                      const ErrorMapSettings& settings) {
   if (!cell.plan) return std::optional<InspectionPlan>();
-  auto plan = ParsePlanWithDefaults(*cell.plan, part, settings);
+  auto plan = ParsePlanForMeshFile(*cell.plan, part, cell.part_mesh, settings);
   if (!plan.ok()) return Bad(cell.plan_source, plan.status().message());
   return std::optional<InspectionPlan>(*std::move(plan));
 }

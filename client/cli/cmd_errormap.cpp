@@ -146,7 +146,7 @@ void RunErrorMap(const ErrorMapArgs& a) {
   // A bad plan is refused before anything is measured.
   const InspectionPlan plan = a.plan.empty()
                                   ? PlanFromSettings(a.settings)
-                                  : Take(ParsePlanWithDefaults(plan_json, mesh, a.settings));
+                                  : Take(ParsePlanForMeshFile(plan_json, mesh, a.mesh, a.settings));
   spdlog::info("read {} points and {} triangles in {:.3f} s", cloud_in_world.size(),
                mesh.num_triangles(), Seconds(t0));
   const MeshTopology topo = AnalyzeTopology(mesh);

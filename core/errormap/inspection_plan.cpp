@@ -197,4 +197,16 @@ absl::StatusOr<ResolvedInspectionPlan> ResolveInspectionPlan(const InspectionPla
   return r;
 }
 
+void SelectGroupsByTriangles(InspectionPlan* plan, const MeshGroups& groups) {
+  for (PlanRegion& r : plan->regions) {
+    if (r.select.kind != RegionSelector::Kind::kGroup) continue;
+    const auto g = static_cast<uint32_t>(
+        std::find(groups.names.begin(), groups.names.end(), r.select.group) - groups.names.begin());
+    r.select.kind = RegionSelector::Kind::kTriangles;
+    r.select.triangles.clear();
+    for (std::size_t t = 0; t < groups.triangle_group.size(); ++t)
+      if (groups.triangle_group[t] == g) r.select.triangles.push_back(static_cast<uint32_t>(t));
+  }
+}
+
 }  // namespace surfinspect

@@ -26,6 +26,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "core/types/mesh_groups.h"
 #include "core/types/triangle_mesh.h"
 
 namespace surfinspect {
@@ -88,17 +89,6 @@ struct InspectionPlan {
   std::optional<DefectRules> defects;  // unset: no defect detection
 };
 
-// Named triangle groups of the CAD file. An OBJ file's `g NAME` and `o NAME`
-// statements open a group; every `f` after them belongs to it, so a reader
-// fills `names` in order of first appearance and `triangle_group[t]` with
-// the index of the group open when triangle t was read (kNoGroup before any).
-// A face with several names (`g a b`) goes to the first. Empty = no groups.
-struct MeshGroups {
-  static constexpr uint32_t kNoGroup = UINT32_MAX;
-  std::vector<std::string> names;
-  std::vector<uint32_t> triangle_group;  // size 0 or part.num_triangles()
-};
-
 // Checks the plan against the part it will be applied to: finite numbers,
 // lower <= upper, a non-empty box with min <= max, radius > 0, fractions in
 // [0, 1], triangle ids in range, groups that exist, non-empty names unique
@@ -136,6 +126,11 @@ struct ResolvedInspectionPlan {
     return static_cast<int>(region_ids[region_offsets[t]]);
   }
 };
+
+// Turns every group selector into the triangle ids of its group, so the plan
+// no longer needs the CAD file's groups (a server gets the plan, not the
+// file). The plan was validated against `groups`.
+void SelectGroupsByTriangles(InspectionPlan* plan, const MeshGroups& groups);
 
 // Validates, then resolves. Region ids per triangle are in increasing order.
 absl::StatusOr<ResolvedInspectionPlan> ResolveInspectionPlan(const InspectionPlan& plan,

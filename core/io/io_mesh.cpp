@@ -12,6 +12,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/io/atomic_file.h"
 #include "core/io/mesh_precheck.h"
+#include "core/io/obj_groups.h"
 #include "core/io/off_format.h"
 #include "core/io/ply_format.h"
 #include "core/io/ply_mesh.h"
@@ -88,6 +89,14 @@ absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path, const MeshReadLim
         path, ": ", mesh->num_triangles(), " faces exceed the limit of ", limits.max_triangles));
   if (auto st = mesh->Validate(); !st.ok()) return Bad(path, st.message());
   return mesh;
+}
+
+absl::StatusOr<MeshGroups> ReadMeshGroups(const std::string& path, const TriangleMesh& mesh,
+                                          const MeshReadLimits& limits) {
+  if (Extension(path) != "obj") return MeshGroups{};
+  auto bytes = ReadWholeFile(path, limits.max_file_bytes);
+  if (!bytes.ok()) return bytes.status();
+  return ObjGroups(*bytes, mesh, path);
 }
 
 bool PlyDeclaresFaces(const std::string& path) {

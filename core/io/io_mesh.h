@@ -12,6 +12,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/io/read_limits.h"
+#include "core/types/mesh_groups.h"
 #include "core/types/triangle_mesh.h"
 
 namespace surfinspect {
@@ -19,6 +20,12 @@ namespace surfinspect {
 // Fails with a message naming the file for: unreadable or truncated files,
 // no triangles, non-finite vertices, only degenerate triangles, limits.
 absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path, const MeshReadLimits& limits = {});
+
+// The named groups of the file ReadMesh read as `mesh`: an OBJ's `g` / `o`
+// groups (obj_groups.h); empty for other formats and files without groups.
+// FailedPrecondition when the groups cannot be mapped onto the triangles.
+absl::StatusOr<MeshGroups> ReadMeshGroups(const std::string& path, const TriangleMesh& mesh,
+                                          const MeshReadLimits& limits = {});
 
 // True when the file's PLY header parses and declares a face element with
 // rows: such a PLY is a mesh, any other a point cloud.

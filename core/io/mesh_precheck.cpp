@@ -3,6 +3,7 @@
 #include <cstring>
 
 #include "absl/strings/str_cat.h"
+#include "core/io/obj_lines.h"
 #include "core/io/text_parse.h"
 
 namespace surfinspect {
@@ -152,21 +153,6 @@ bool CornerOk(std::string_view c, const ObjCounts& total, const ObjCounts& so_fa
   if (!vt.empty() && !IndexOk(vt, total.vt, so_far.vt)) return false;
   if (s2 == std::string_view::npos) return !vt.empty();
   return IndexOk(rest.substr(s2 + 1), total.vn, so_far.vn);
-}
-
-// Calls visit(tokens, line number) for every OBJ line with a token, comments
-// (from '#') cut; stops at the first error visit returns.
-template <typename Visit>
-absl::Status ForEachObjLine(std::string_view bytes, Visit&& visit) {
-  LineScanner lines(bytes);
-  std::string_view line;
-  std::vector<std::string_view> tok;
-  while (lines.Next(&line)) {
-    SplitWhitespace(line.substr(0, line.find('#')), &tok);
-    if (tok.empty()) continue;
-    if (absl::Status st = visit(tok, lines.line_number()); !st.ok()) return st;
-  }
-  return absl::OkStatus();
 }
 
 ObjCounts CountObjEntries(std::string_view bytes) {

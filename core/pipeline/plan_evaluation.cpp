@@ -1,7 +1,9 @@
 #include "core/pipeline/plan_evaluation.h"
 
+#include "absl/strings/str_cat.h"
 #include "core/errormap/error_map_output.h"
 #include "core/errormap/plan_report.h"
+#include "core/io/io_mesh.h"
 
 namespace surfinspect {
 
@@ -15,14 +17,30 @@ InspectionPlan PlanFromSettings(const ErrorMapSettings& settings) {
 absl::StatusOr<InspectionPlan> ParsePlanWithDefaults(const nlohmann::json& json,
                                                      const TriangleMesh& part,
                                                      const ErrorMapSettings& settings,
-                                                     const std::string& where) {
+                                                     const std::string& where,
+                                                     const MeshGroups& groups) {
   if (!json.is_object()) return absl::InvalidArgumentError(where + ": must be an object");
   nlohmann::json with = json;
   if (!with.contains("tolerance_mm"))
     with["tolerance_mm"] = {{"lower", -settings.tolerance_mm}, {"upper", settings.tolerance_mm}};
   if (!with.contains("allowed_fraction_outside"))
     with["allowed_fraction_outside"] = settings.allowed_fraction_outside;
-  return ParseInspectionPlan(with, part, where);
+  auto plan = ParseInspectionPlan(with, part, where, groups);
+  if (plan.ok()) SelectGroupsByTriangles(&*plan, groups);
+  return plan;
+}
+
+absl::StatusOr<InspectionPlan> ParsePlanForMeshFile(const nlohmann::json& json,
+                                                    const TriangleMesh& part,
+                                                    const std::string& mesh_path,
+                                                    const ErrorMapSettings& settings,
+                                                    const std::string& where) {
+  const absl::StatusOr<MeshGroups> groups = ReadMeshGroups(mesh_path, part);
+  auto plan =
+      ParsePlanWithDefaults(json, part, settings, where, groups.ok() ? *groups : MeshGroups{});
+  if (plan.ok() || groups.ok()) return plan;
+  return absl::Status(plan.status().code(),
+                      absl::StrCat(plan.status().message(), " (", groups.status().message(), ")"));
 }
 
 absl::StatusOr<PlanOutcome> EvaluatePlan(const ErrorMapResult& error_map, const PointCloud& cloud,

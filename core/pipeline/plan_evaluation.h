@@ -34,11 +34,22 @@ InspectionPlan PlanFromSettings(const ErrorMapSettings& settings);
 // ParseInspectionPlan with the error-map settings as defaults: a plan
 // without "tolerance_mm" takes {-t, +t} of settings.tolerance_mm, one without
 // "allowed_fraction_outside" takes the settings' (the symmetric --tolerance
-// is the shorthand of the plan's band).
+// is the shorthand of the plan's band). Group selectors name `groups` of the
+// CAD file and come back as the triangle ids of their group.
 absl::StatusOr<InspectionPlan> ParsePlanWithDefaults(const nlohmann::json& json,
                                                      const TriangleMesh& part,
                                                      const ErrorMapSettings& settings,
-                                                     const std::string& where = "plan");
+                                                     const std::string& where = "plan",
+                                                     const MeshGroups& groups = {});
+
+// ParsePlanWithDefaults with the groups of the CAD file `mesh_path` that
+// `part` was read from (io_mesh.h ReadMeshGroups). A file whose groups cannot
+// be read has none; a plan that selects one is then refused with that reason.
+absl::StatusOr<InspectionPlan> ParsePlanForMeshFile(const nlohmann::json& json,
+                                                    const TriangleMesh& part,
+                                                    const std::string& mesh_path,
+                                                    const ErrorMapSettings& settings,
+                                                    const std::string& where = "plan");
 
 struct PlanOutcome {
   CharacteristicsResult characteristics;  // surface, regions, points

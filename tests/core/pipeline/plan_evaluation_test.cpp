@@ -6,10 +6,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <random>
 
 #include "core/errormap/error_map_output.h"
 #include "core/errormap/plan_report.h"
+#include "core/io/io_mesh.h"
+#include "tests/support/temp_dir.h"
 #include "tests/support/test_meshes.h"
 
 namespace surfinspect {
@@ -196,6 +199,66 @@ TEST(PlanEvaluation, ReportTwoKeepsTheErrorMapBlocksAndAddsTheResults) {
   EXPECT_EQ(k["characteristics"][0]["name"], "surface");
   EXPECT_EQ(k["characteristics"][0]["tolerance_mm"]["lower"], -0.1);
   EXPECT_TRUE(k["defects"].is_array() && k["defects"].empty());
+}
+
+// A region that selects an OBJ group judges the same points as a box around
+// the same triangles: the file's `g left` / `g right` split the plane at
+// x = 25, where no triangle's centroid lies.
+TEST(PlanEvaluation, GroupSelectorsOfAnObjFileJudgeTheirGroupsTriangles) {
+  const Scene s = MakeScene();
+  testing::TempDir dir;
+  const std::string obj = dir.File("part.obj");
+  {
+    std::ofstream out(obj);
+    for (const auto& v : s.mesh.vertices)
+      out << "v " << v.x() << " " << v.y() << " " << v.z() << "\n";
+    for (const char* side : {"left", "right"}) {
+      out << "g " << side << "\n";
+      for (const auto& t : s.mesh.triangles) {
+        const double cx =
+            (s.mesh.vertices[t[0]].x() + s.mesh.vertices[t[1]].x() + s.mesh.vertices[t[2]].x()) / 3;
+        if ((cx < 25) == (std::string(side) == "left"))
+          out << "f " << t[0] + 1 << " " << t[1] + 1 << " " << t[2] + 1 << "\n";
+      }
+    }
+  }
+  auto part = ReadMesh(obj);
+  ASSERT_TRUE(part.ok()) << part.status();
+  auto index = MeshIndex::Build(*part);
+  ASSERT_TRUE(index.ok());
+  auto em = ComputeErrorMap(**index, s.cloud, Eigen::Isometry3d::Identity(), {});
+  ASSERT_TRUE(em.ok());
+  const auto plan_with = [&](const char* select) {
+    auto plan = ParsePlanForMeshFile(
+        nlohmann::json::parse(std::string(R"({"regions": [{"name": "left", "select": )") + select +
+                              "}]}"),
+        *part, obj, ErrorMapSettings{});
+    EXPECT_TRUE(plan.ok()) << plan.status();
+    return plan.ok() ? *plan : InspectionPlan{};
+  };
+  const InspectionPlan by_group = plan_with(R"({"group": "left"})");
+  ASSERT_EQ(by_group.regions.size(), 1u);
+  // The group is now triangle ids: a server needs no CAD file to apply it.
+  EXPECT_EQ(by_group.regions[0].select.kind, RegionSelector::Kind::kTriangles);
+  EXPECT_EQ(by_group.regions[0].select.triangles.size(), part->num_triangles() / 2);
+  const InspectionPlan by_box = plan_with(R"({"box_mm": [[0, 0, -1], [25, 50, 1]]})");
+  auto a = EvaluatePlan(*em, s.cloud, *part, by_group);
+  auto b = EvaluatePlan(*em, s.cloud, *part, by_box);
+  ASSERT_TRUE(a.ok() && b.ok());
+  const CharacteristicResult& ra = a->characteristics.characteristics[1];
+  const CharacteristicResult& rb = b->characteristics.characteristics[1];
+  EXPECT_GT(ra.points, 1000u);
+  EXPECT_EQ(ra.points, rb.points);
+  EXPECT_EQ(ra.mean_mm, rb.mean_mm);
+  EXPECT_EQ(ra.min_mm, rb.min_mm);
+
+  auto unknown = ParsePlanForMeshFile(
+      nlohmann::json::parse(R"({"regions": [{"name": "r", "select": {"group": "top"}}]})"), *part,
+      obj, ErrorMapSettings{});
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_NE(unknown.status().message().find("unknown group \"top\" (the part has 2 named groups)"),
+            std::string::npos)
+      << unknown.status();
 }
 
 }  // namespace

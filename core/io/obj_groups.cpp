@@ -1,0 +1,125 @@
+#include "core/io/obj_groups.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "core/io/obj_lines.h"
+#include "core/io/text_parse.h"
+
+namespace surfinspect {
+namespace {
+
+struct ObjFace {
+  std::vector<uint32_t> corners;  // 0-based vertex indices
+  uint32_t group = MeshGroups::kNoGroup;
+  std::size_t line = 0;
+};
+
+struct ObjFaces {
+  std::vector<Eigen::Vector3f> vertices;
+  std::vector<ObjFace> faces;
+  MeshGroups groups;  // names only
+};
+
+// A corner "v", "v/vt", "v//vn" or "v/vt/vn" as a 0-based vertex index;
+// negative indices count back from the vertices read so far.
+bool CornerVertex(std::string_view corner, std::size_t so_far, uint32_t* out) {
+  int64_t i = 0;
+  if (!ParseInt(corner.substr(0, corner.find('/')), &i) || i == 0) return false;
+  const int64_t index = i > 0 ? i - 1 : static_cast<int64_t>(so_far) + i;
+  if (index < 0 || index >= static_cast<int64_t>(UINT32_MAX)) return false;
+  *out = static_cast<uint32_t>(index);
+  return true;
+}
+
+void OpenGroup(const std::vector<std::string_view>& tok, MeshGroups* groups, uint32_t* open) {
+  *open = MeshGroups::kNoGroup;
+  if (tok.size() < 2) return;
+  const std::string name(tok[1]);
+  for (std::size_t g = 0; g < groups->names.size(); ++g)
+    if (groups->names[g] == name) *open = static_cast<uint32_t>(g);
+  if (*open != MeshGroups::kNoGroup) return;
+  *open = static_cast<uint32_t>(groups->names.size());
+  groups->names.push_back(name);
+}
+
+absl::StatusOr<ObjFaces> ReadFaces(std::string_view bytes, std::string_view name) {
+  ObjFaces r;
+  uint32_t open = MeshGroups::kNoGroup;
+  absl::Status st = ForEachObjLine(
+      bytes, [&](const std::vector<std::string_view>& tok, std::size_t line) -> absl::Status {
+        if (tok[0] == "g" || tok[0] == "o") {
+          OpenGroup(tok, &r.groups, &open);
+        } else if (tok[0] == "v" && tok.size() >= 4) {
+          double x, y, z;
+          if (!ParseDouble(tok[1], &x) || !ParseDouble(tok[2], &y) || !ParseDouble(tok[3], &z))
+            return BadFile(name, absl::StrCat("OBJ line ", line, ": bad vertex"));
+          r.vertices.emplace_back(static_cast<float>(x), static_cast<float>(y),
+                                  static_cast<float>(z));
+        } else if (tok[0] == "f") {
+          ObjFace f{{}, open, line};
+          for (std::size_t k = 1; k < tok.size(); ++k) {
+            uint32_t v;
+            if (!CornerVertex(tok[k], r.vertices.size(), &v) || v >= r.vertices.size())
+              return BadFile(name, absl::StrCat("OBJ line ", line, ": bad face index"));
+            f.corners.push_back(v);
+          }
+          if (f.corners.size() >= 3) r.faces.push_back(std::move(f));
+        }
+        return absl::OkStatus();
+      });
+  if (!st.ok()) return st;
+  return r;
+}
+
+// Assimp parses numbers with its own routine, so positions may differ from
+// ours in the last bits of the float: equal within 1e-6 relative.
+bool SamePosition(const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
+  for (int k = 0; k < 3; ++k)
+    if (std::abs(a[k] - b[k]) > 1e-6f * std::max(1.0f, std::abs(b[k]))) return false;
+  return true;
+}
+
+bool CornersOf(const TriangleMesh& mesh, std::size_t t, const ObjFaces& file, const ObjFace& f) {
+  for (int c = 0; c < 3; ++c) {
+    const Eigen::Vector3f& p = mesh.vertices[mesh.triangles[t][c]];
+    bool found = false;
+    for (uint32_t v : f.corners) found = found || SamePosition(p, file.vertices[v]);
+    if (!found) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+absl::StatusOr<MeshGroups> ObjGroups(std::string_view bytes, const TriangleMesh& imported,
+                                     std::string_view name) {
+  auto file = ReadFaces(bytes, name);
+  if (!file.ok()) return file.status();
+  MeshGroups groups;
+  if (file->groups.names.empty()) return groups;
+  groups.names = file->groups.names;
+  groups.triangle_group.reserve(imported.num_triangles());
+  std::size_t t = 0;
+  for (const ObjFace& f : file->faces) {
+    for (std::size_t k = 0; k + 2 < f.corners.size(); ++k, ++t) {
+      if (t >= imported.num_triangles() || !CornersOf(imported, t, *file, f))
+        return absl::FailedPreconditionError(absl::StrCat(
+            ToAbsl(name), ": OBJ groups cannot be mapped: the imported triangle ", t,
+            " is not part of the face on line ", f.line,
+            " (the importer reorders faces of different materials; use one material per "
+            "group, or select regions by box or triangle ids)"));
+      groups.triangle_group.push_back(f.group);
+    }
+  }
+  if (t != imported.num_triangles())
+    return absl::FailedPreconditionError(
+        absl::StrCat(ToAbsl(name), ": OBJ groups cannot be mapped: the file's faces give ", t,
+                     " triangles, the import ", imported.num_triangles()));
+  return groups;
+}
+
+}  // namespace surfinspect
