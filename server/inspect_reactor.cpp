@@ -124,6 +124,7 @@ grpc::Status InspectReactor::RunInspection() {
     if (!png.ok()) return ToGrpc(png.status());
     resp.mutable_result()->set_png(*std::move(png));
   }
+  if (grpc::Status fits = service_->FitsOneMessage(resp, "Inspect result"); !fits.ok()) return fits;
   Send(std::move(resp));
   return grpc::Status::OK;
 }

@@ -124,6 +124,18 @@ grpc::Status InspectionService::Reserve(uint64_t bytes, const std::string& what,
   return grpc::Status::OK;
 }
 
+grpc::Status InspectionService::FitsOneMessage(const google::protobuf::MessageLite& response,
+                                               const char* what) const {
+  const uint64_t bytes = response.ByteSizeLong();
+  if (bytes <= config_.max_message_bytes) return grpc::Status::OK;
+  return grpc::Status(
+      grpc::StatusCode::FAILED_PRECONDITION,
+      absl::StrCat("RESPONSE_TOO_LARGE: the ", what, " is ", (bytes + (1 << 20) - 1) >> 20,
+                   " MiB, over the server's message limit of ", config_.max_message_bytes >> 20,
+                   " MiB; ask for less (fewer points, no deviations or PNG) or raise "
+                   "--max-message-mb on the server and the client"));
+}
+
 grpc::Status InspectionService::Authorize(const grpc::CallbackServerContext* ctx) const {
   if (config_.auth_token.empty()) return grpc::Status::OK;
   const auto& md = ctx->client_metadata();
@@ -234,7 +246,7 @@ grpc::ServerUnaryReactor* InspectionService::Filter(grpc::CallbackServerContext*
     if (auto st = RemoveOutliers(*cloud, *settings, clusters, &cancel); !st.ok())
       return FromCore(st);
     wire::FilterResultToProto(*cloud, clusters, resp);
-    return grpc::Status::OK;
+    return FitsOneMessage(*resp, "Filter response");
   });
 }
 
@@ -266,7 +278,7 @@ grpc::ServerUnaryReactor* InspectionService::Calibrate(grpc::CallbackServerConte
             CalibrateViewpoint(*gauge, *world_from_gauge, *scan, *initial, settings, &cancel);
         if (!cal.ok()) return FromCore(cal.status());
         wire::CalibrationToProto(*cal, resp);
-        return grpc::Status::OK;
+        return FitsOneMessage(*resp, "Calibrate response");
       });
 }
 
@@ -312,7 +324,7 @@ grpc::ServerUnaryReactor* InspectionService::Register(grpc::CallbackServerContex
           wire::TransformToProto(fit->correction, resp->mutable_best_fit_correction());
         }
         wire::MergedCloudToProto(*merged, resp);
-        return grpc::Status::OK;
+        return FitsOneMessage(*resp, "Register response");
       });
 }
 
@@ -344,7 +356,7 @@ grpc::ServerUnaryReactor* InspectionService::ErrorMap(grpc::CallbackServerContex
       if (!png.ok()) return FromCore(png.status());
       resp->set_png(*std::move(png));
     }
-    return grpc::Status::OK;
+    return FitsOneMessage(*resp, "ErrorMap response");
   });
 }
 

@@ -35,6 +35,9 @@ struct ServiceConfig {
   uint64_t memory_budget_bytes = 0;
   std::string auth_token;  // empty = no bearer-token check
   bool json_logs = false;
+  // The largest message gRPC will send (--max-message-mb); a result over it
+  // is refused by the service with the sizes, not lost in the transport.
+  uint64_t max_message_bytes = uint64_t{64} << 20;
 };
 
 class InspectionService final : public v1::InspectionService::CallbackService {
@@ -67,6 +70,10 @@ class InspectionService final : public v1::InspectionService::CallbackService {
   // UNAUTHENTICATED unless the call carries "authorization: Bearer <token>"
   // (when a token is configured).
   grpc::Status Authorize(const grpc::CallbackServerContext* ctx) const;
+  // OK when `response` fits one message; else FAILED_PRECONDITION with its
+  // size and the limit. Not retryable: the same request gives the same size.
+  grpc::Status FitsOneMessage(const google::protobuf::MessageLite& response,
+                              const char* what) const;
   // Inline mesh: validated, indexed and cached under its hash. By hash: from
   // the cache, or FAILED_PRECONDITION "MESH_NOT_CACHED" (+ trailer).
   grpc::Status ResolveMesh(grpc::CallbackServerContext* ctx, const v1::MeshRef& ref,

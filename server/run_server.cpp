@@ -80,6 +80,7 @@ absl::Status RunServer(const ServerOptions& options) {
 
   ServiceConfig config = options.service;
   config.memory_budget_bytes = MemoryBudgetBytes(options);
+  config.max_message_bytes = uint64_t(options.max_message_mb) << 20;
   InspectionService service(config, metrics->get());
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();

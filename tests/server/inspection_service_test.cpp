@@ -187,6 +187,35 @@ TEST(InspectionService, ThePlanTravelsTypedAndTheResultsAreTypedToo) {
   EXPECT_EQ(iresp->part_verdict() == v1::VERDICT_PASS, r.plan.pass());
 }
 
+// A result larger than one gRPC message is refused by the service, with the
+// sizes, and logged as the refusal: the transport would otherwise fail it
+// after the server had logged the call as OK.
+TEST(InspectionService, AResultOverTheMessageLimitIsRefusedWithItsSize) {
+  testing::ServerProcess server({"--max-message-mb", "2"});
+  ASSERT_TRUE(server.started());
+  RemoteOptions o;
+  o.chunk_bytes = 256 << 10;
+  auto client = ClientFor(server, o);
+  const Data& d = TestData();
+  v1::PartHeader header;
+  header.set_part_id("big");
+  wire::TransformToProto(d.cell.world_from_part, header.mutable_world_from_part());
+  header.set_return_deviations(true);
+  auto r = client->Inspect(header, d.cell.part, d.views, {});
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), absl::StatusCode::kFailedPrecondition) << r.status();
+  EXPECT_NE(r.status().message().find("RESPONSE_TOO_LARGE: the Inspect result is "),
+            std::string::npos)
+      << r.status();
+  EXPECT_NE(r.status().message().find("message limit of 2 MiB"), std::string::npos);
+  EXPECT_EQ(*client->Health(), "SERVING");
+  server.Terminate();
+  std::ifstream log(server.log_path());
+  const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("Inspect from"), std::string::npos);
+  EXPECT_NE(text.find("FAILED_PRECONDITION (RESPONSE_TOO_LARGE"), std::string::npos) << text;
+}
+
 TEST(InspectionService, EveryRpcMatchesInProcess) {
   testing::ServerProcess server;
   ASSERT_TRUE(server.started());
