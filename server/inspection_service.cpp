@@ -160,6 +160,12 @@ grpc::Status InspectionService::ResolveMesh(grpc::CallbackServerContext* ctx,
       return grpc::Status::OK;
     }
     metrics_->MeshCacheMiss();
+    MemoryBudget::Reservation building;
+    const uint64_t triangles = ref.inline_().triangles().size() / 12;
+    if (grpc::Status room =
+            Reserve(triangles * MeshIndexBytesPerTriangle(), field + " mesh index", &building);
+        !room.ok())
+      return room;
     auto mesh = wire::MeshFromProto(ref.inline_(), field + ".inline", config_.limits);
     if (!mesh.ok()) return FromCore(mesh.status());
     auto index = MeshIndex::Build(*std::move(mesh));

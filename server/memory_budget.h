@@ -82,5 +82,7 @@ MemoryLimits DetectMemoryLimits();
 // memory_budget.cpp for the breakdown).
 uint64_t InspectBytesPerPoint();
 uint64_t UnaryCloudBytesPerPoint();
+// Bytes an inline mesh holds per triangle while its index is built.
+uint64_t MeshIndexBytesPerTriangle();
 
 }  // namespace surfinspect::server

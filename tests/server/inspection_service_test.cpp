@@ -337,6 +337,33 @@ class RawCalls {
   std::unique_ptr<v1::InspectionService::Stub> stub_;
 };
 
+// Building an inline mesh's index reserves its memory first: a mesh whose
+// index does not fit the budget is RESOURCE_EXHAUSTED, named, before it is
+// built, and the same call with a smaller mesh goes through.
+TEST(InspectionService, AnInlineMeshIndexThatDoesNotFitIsRefusedBeforeItIsBuilt) {
+  testing::ServerProcess server({"--max-memory-mb", "2"});
+  ASSERT_TRUE(server.started());
+  RawCalls raw(server.target());
+  const Data& d = TestData();
+  PointCloud few = d.merged_world;
+  few.points.resize(100);
+  few.width = 100;
+  few.height = 1;
+  v1::ErrorMapRequest req = ErrorMapRequest(few);
+  wire::MeshToProto(d.cell.part, req.mutable_part()->mutable_inline_());  // 4440 triangles
+  using S = v1::InspectionService::Stub;
+  const grpc::Status refused =
+      raw.Call<v1::ErrorMapRequest, v1::ErrorMapResponse>(&S::ErrorMap, req);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_NE(refused.error_message().find("part mesh index"), std::string::npos)
+      << refused.error_message();
+  TriangleMesh small = d.cell.part;
+  small.triangles.resize(1000);
+  wire::MeshToProto(small, req.mutable_part()->mutable_inline_());
+  const grpc::Status ok = raw.Call<v1::ErrorMapRequest, v1::ErrorMapResponse>(&S::ErrorMap, req);
+  EXPECT_TRUE(ok.ok()) << ok.error_message();
+}
+
 TEST(InspectionService, BadRequestsGetTheRightCodeAndTheServerStaysUp) {
   testing::ServerProcess server({"--max-points", "2000000", "--max-triangles", "100000"});
   ASSERT_TRUE(server.started());

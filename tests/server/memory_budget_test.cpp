@@ -2,8 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <thread>
 #include <vector>
+
+#include "core/distance/mesh_index.h"
+#include "core/simulation/demo_cell.h"
 
 namespace surfinspect::server {
 namespace {
@@ -80,6 +84,20 @@ TEST(MemoryBudget, DefaultBudgetFollowsTheTightestLimit) {
   }
   EXPECT_GT(m.default_budget_bytes, 0u);
   EXPECT_FALSE(m.source.empty());
+}
+
+// The reservation for building an inline mesh's index covers the finished
+// index (mesh, normals, Embree's BVH) twice over, for the build's transient
+// memory: measured on the demo part and on a fine torus.
+TEST(MemoryBudget, TheMeshIndexReservationCoversTheIndexTwice) {
+  for (const TriangleMesh& mesh : {MakeDemoCell().part, MakeDemoCell().gauge}) {
+    auto index = MeshIndex::Build(mesh);
+    ASSERT_TRUE(index.ok());
+    const double per_triangle =
+        static_cast<double>((*index)->memory_bytes()) / static_cast<double>(mesh.num_triangles());
+    std::printf("index: %zu triangles, %.1f B per triangle\n", mesh.num_triangles(), per_triangle);
+    EXPECT_LE(2 * per_triangle, static_cast<double>(MeshIndexBytesPerTriangle()));
+  }
 }
 
 }  // namespace
