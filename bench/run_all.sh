@@ -29,4 +29,13 @@ if [ "${BENCH_SKIP_GBENCH:-0}" != 1 ]; then
     mv "$tmp" "$RESULTS_DIR/gbench-$b.txt"
   done
 fi
+# Stand-alone benches with goals of their own; each prints its table, kept
+# as RESULTS_DIR/NAME.txt.
+for b in inspection_plan_bench; do
+  [ -x "$BIN_DIR/$b" ] || die "$BIN_DIR/$b not built"
+  log "$b"
+  tmp=$(mktemp "$RESULTS_DIR/.$b.XXXXXX")
+  "$BIN_DIR/$b" >"$tmp" || { rm -f "$tmp"; die "$b failed"; }
+  mv "$tmp" "$RESULTS_DIR/$b.txt"
+done
 log "done in $(( $(date +%s) - start )) s; table: $RESULTS_DIR/latest.md"
