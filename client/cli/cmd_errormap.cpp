@@ -49,6 +49,8 @@ struct ErrorMapRun {
   nlohmann::json report;
   std::string png_bytes;
   std::vector<std::string> failed, defects;  // for the summary
+  // Stage times, s, merged into the report's "timing" block.
+  double build_seconds = 0, plan_seconds = 0, png_seconds = 0;
 };
 
 // The server computes; PLY/CSV are written here from its deviations, the
@@ -89,21 +91,26 @@ ErrorMapRun LocalErrorMap(const ErrorMapArgs& a, const PointCloud& cloud_in_worl
                index->info().build_seconds, topo.boundary_edges,
                index->info().degenerate_triangles);
   ErrorMapRun run;
+  run.build_seconds = index->info().build_seconds;
   run.result = Take(ComputeErrorMap(*index, cloud_in_world, world_from_part, a.settings));
   spdlog::info("distances for {} points in {:.3f} s", run.result.stats.count,
                run.result.query_seconds);
+  auto t0 = std::chrono::steady_clock::now();
   const PlanOutcome outcome =
       Take(EvaluatePlan(run.result, cloud_in_world, index->mesh(), plan, a.settings.threads));
+  run.plan_seconds = Seconds(t0);
   run.report = InspectionReportJson(run.result, a.settings, outcome);
   run.failed = client::FailedLines(outcome.characteristics);
   run.defects = client::DefectLines(outcome.defects);
   if (!a.png.empty()) {
+    t0 = std::chrono::steady_clock::now();
     ErrorMapPngOptions png;
     png.defects = &outcome.defects.defects;
     png.part_pass = outcome.pass();
     png.view_axis = a.png_axis == "x" ? 0 : a.png_axis == "y" ? 1 : a.png_axis == "z" ? 2 : -1;
     run.png_bytes = Take(EncodePng(
         Take(RenderErrorMap(cloud_in_part, run.result, ComputeBounds(index->mesh()), png))));
+    run.png_seconds = Seconds(t0);
   }
   return run;
 }
@@ -147,8 +154,9 @@ void RunErrorMap(const ErrorMapArgs& a) {
   const InspectionPlan plan = a.plan.empty()
                                   ? PlanFromSettings(a.settings)
                                   : Take(ParsePlanForMeshFile(plan_json, mesh, a.mesh, a.settings));
+  const double read_seconds = Seconds(t0);
   spdlog::info("read {} points and {} triangles in {:.3f} s", cloud_in_world.size(),
-               mesh.num_triangles(), Seconds(t0));
+               mesh.num_triangles(), read_seconds);
   const MeshTopology topo = AnalyzeTopology(mesh);
   const nlohmann::json mesh_json = {{"triangles", mesh.num_triangles()},
                                     {"boundary_edges", topo.boundary_edges},
@@ -161,10 +169,21 @@ void RunErrorMap(const ErrorMapArgs& a) {
                                         std::move(mesh), topo, plan);
   // Files carry part-frame coordinates by default, so they overlay the CAD.
   const PointCloud& written = a.frame == "world" ? cloud_in_world : cloud_in_part;
+  const auto t_write = std::chrono::steady_clock::now();
   Check(WriteErrorMapPly(a.out, written, run.result, a.frame));
   if (!a.csv.empty()) Check(WriteErrorMapCsv(a.csv, written, run.result));
   if (!a.png.empty()) Check(WriteStringAtomically(a.png, run.png_bytes));
   if (!a.report.empty()) {
+    // The remote report's timing is the server's; the local one is all ours.
+    nlohmann::json& timing = run.report["timing"];
+    timing["read_seconds"] = read_seconds;
+    if (!a.remote.remote()) {
+      timing["build_seconds"] = run.build_seconds;
+      timing["plan_seconds"] = run.plan_seconds;
+      timing["png_seconds"] = run.png_seconds;
+    }
+    timing["write_seconds"] = Seconds(t_write);
+    timing["total_seconds"] = Seconds(t0);
     run.report["inputs"] = {
         {"cloud", a.cloud}, {"mesh", a.mesh}, {"world_from_part", a.world_from_part}};
     run.report["mesh"] = mesh_json;

@@ -146,9 +146,18 @@ absl::StatusOr<std::vector<ClosestPoint>> QueryClosest(const MeshIndex& index,
 // The same, streaming: `sink(i, result)` is called exactly once for every
 // input index i, concurrently from worker threads (for different i), so
 // callers can store only the fields they need.
+// Where a batch query's time went, s: the visiting order (Morton keys and
+// their sort; 0 for organized clouds) and the searches, which include the
+// signs (a pseudonormal per answer, inside Closest).
+struct BatchQueryTiming {
+  double order_seconds = 0;
+  double search_seconds = 0;
+};
+
 absl::Status QueryClosestEach(const MeshIndex& index, const PointCloud& points,
                               const Eigen::Isometry3d& mesh_from_points,
                               const BatchQuerySettings& settings, const std::atomic<bool>* cancel,
-                              absl::FunctionRef<void(std::size_t, const ClosestPoint&)> sink);
+                              absl::FunctionRef<void(std::size_t, const ClosestPoint&)> sink,
+                              BatchQueryTiming* timing = nullptr);
 
 }  // namespace surfinspect

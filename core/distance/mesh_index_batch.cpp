@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <new>
 
 #include "absl/strings/str_cat.h"
@@ -88,16 +89,19 @@ absl::Status CheckInputs(const PointCloud& points, const Eigen::Isometry3d& mesh
 absl::Status QueryClosestEach(const MeshIndex& index, const PointCloud& points,
                               const Eigen::Isometry3d& mesh_from_points,
                               const BatchQuerySettings& settings, const std::atomic<bool>* cancel,
-                              absl::FunctionRef<void(std::size_t, const ClosestPoint&)> sink) {
+                              absl::FunctionRef<void(std::size_t, const ClosestPoint&)> sink,
+                              BatchQueryTiming* timing) {
   if (auto st = CheckInputs(points, mesh_from_points, settings); !st.ok()) return st;
   const std::size_t n = points.size();
   if (n == 0) return absl::OkStatus();
+  const auto t0 = std::chrono::steady_clock::now();
   // A grid is already coherent row by row; anything else gets Morton order.
   std::vector<uint32_t> order;
   if (settings.coherent_start && !points.organized() && n <= UINT32_MAX) {
     order = MortonOrder(points, cancel);
     if (order.empty()) return absl::CancelledError("closest-point query cancelled");
   }
+  const auto t1 = std::chrono::steady_clock::now();
 
   const double max_d = settings.max_distance_mm;
   std::atomic<bool> cancelled{false};
@@ -147,6 +151,11 @@ absl::Status QueryClosestEach(const MeshIndex& index, const PointCloud& points,
                       });
   });
   if (cancelled.load()) return absl::CancelledError("closest-point query cancelled");
+  if (timing) {
+    timing->order_seconds = std::chrono::duration<double>(t1 - t0).count();
+    timing->search_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+  }
   return index.TakeDeviceError();
 }
 

@@ -179,23 +179,27 @@ absl::StatusOr<ErrorMapResult> ComputeErrorMap(const MeshIndex& index,
   query.max_distance_mm = settings.max_distance_mm;
   query.threads = settings.threads;
   const auto start = std::chrono::steady_clock::now();
-  auto st =
-      QueryClosestEach(index, cloud_in_world, part_from_world, query, cancel,
-                       [&](std::size_t i, const ClosestPoint& c) {
-                         if (!c.matched()) return;
-                         r.deviation_mm[i] = static_cast<float>(c.signed_distance_mm);
-                         r.triangle_id[i] = c.triangle_id;
-                         r.closest_point[i] = c.point.cast<float>();
-                         if (split) {
-                           const Eigen::Vector3d diff =
-                               part_from_world * cloud_in_world.points[i].cast<double>() - c.point;
-                           r.deviation_xyz_mm[i] = diff.cast<float>();
-                           // The paper's eq. (6): the offset projected on the face normal.
-                           r.normal_deviation_mm[i] = static_cast<float>(diff.dot(c.normal));
-                         }
-                       });
+  BatchQueryTiming timing;
+  auto st = QueryClosestEach(
+      index, cloud_in_world, part_from_world, query, cancel,
+      [&](std::size_t i, const ClosestPoint& c) {
+        if (!c.matched()) return;
+        r.deviation_mm[i] = static_cast<float>(c.signed_distance_mm);
+        r.triangle_id[i] = c.triangle_id;
+        r.closest_point[i] = c.point.cast<float>();
+        if (split) {
+          const Eigen::Vector3d diff =
+              part_from_world * cloud_in_world.points[i].cast<double>() - c.point;
+          r.deviation_xyz_mm[i] = diff.cast<float>();
+          // The paper's eq. (6): the offset projected on the face normal.
+          r.normal_deviation_mm[i] = static_cast<float>(diff.dot(c.normal));
+        }
+      },
+      &timing);
   if (!st.ok()) return st;
-  r.query_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const auto queried = std::chrono::steady_clock::now();
+  r.query_seconds = std::chrono::duration<double>(queried - start).count();
+  r.order_seconds = timing.order_seconds;
 
   r.stats.count = n;
   r.stats.valid = cloud_in_world.CountValid();
@@ -210,6 +214,8 @@ absl::StatusOr<ErrorMapResult> ComputeErrorMap(const MeshIndex& index,
     }
     for (int a = 0; a < 4; ++a) r.component_stats[a] = Summarize(comp[a]);
   }
+  r.statistics_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - queried).count();
   return r;
 }
 

@@ -209,7 +209,9 @@ nlohmann::json ErrorMapReportJson(const ErrorMapResult& r, const ErrorMapSetting
                        {"y", Stats(r.component_stats[1])},
                        {"z", Stats(r.component_stats[2])},
                        {"normal", Stats(r.component_stats[3])}};
-  j["timing"] = {{"query_seconds", r.query_seconds}};
+  j["timing"] = {{"query_seconds", r.query_seconds},
+                 {"order_seconds", r.order_seconds},
+                 {"statistics_seconds", r.statistics_seconds}};
   return j;
 }
 
