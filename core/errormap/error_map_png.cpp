@@ -118,18 +118,24 @@ RgbImage OrthoMap(const PointCloud& pts, const ErrorMapResult& r, const MapLayou
 }
 
 // Each defect: a black square ring (radius 7 px) around the block of the
-// valid point nearest its centroid, and its id beside it.
+// valid point nearest its centroid, and its id beside it. One pass over the
+// points finds every defect's nearest point (the first of equals).
 void DrawDefects(RgbImage& map, const PointCloud& pts, const MapLayout& l,
                  const std::vector<Defect>& defects) {
-  for (const Defect& d : defects) {
-    const Eigen::Vector3f c = d.centroid_mm.cast<float>();
-    std::size_t best = pts.size();
-    float best_d2 = INFINITY;
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-      if (!PointCloud::IsValid(pts.points[i])) continue;
-      const float d2 = (pts.points[i] - c).squaredNorm();
-      if (d2 < best_d2) best_d2 = d2, best = i;
+  std::vector<Eigen::Vector3f> centroids;
+  for (const Defect& d : defects) centroids.push_back(d.centroid_mm.cast<float>());
+  std::vector<std::size_t> nearest(defects.size(), pts.size());
+  std::vector<float> nearest_d2(defects.size(), INFINITY);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    if (!PointCloud::IsValid(pts.points[i])) continue;
+    for (std::size_t k = 0; k < centroids.size(); ++k) {
+      const float d2 = (pts.points[i] - centroids[k]).squaredNorm();
+      if (d2 < nearest_d2[k]) nearest_d2[k] = d2, nearest[k] = i;
     }
+  }
+  for (std::size_t k = 0; k < defects.size(); ++k) {
+    const Defect& d = defects[k];
+    const std::size_t best = nearest[k];
     if (best == pts.size()) continue;
     const auto [bx, by] = l.BlockOf(best, pts.points[best]);
     const int x = static_cast<int>(bx * l.zoom + l.zoom / 2);
