@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "core/errormap/error_map_output.h"
+#include "core/io/io_point_cloud.h"
 #include "tests/support/temp_dir.h"
 
 namespace surfinspect {
@@ -154,6 +155,17 @@ TEST(ErrorMapPeers, MeshLabReadsQualityAsVcglibDoes) {
     const Rgb c = DeviationColor(f.written[k], 0.1, 0.5);
     EXPECT_EQ(static_cast<uint8_t>(rec[l.props.at("green").second]), c.g);
   }
+}
+
+// Our own cloud reader takes x y z and skips the other properties.
+TEST(ErrorMapPeers, OwnReaderReadsTheErrorMapPlyAsACloud) {
+  const Fixture f = MakeFixture();
+  TempDir dir;
+  ASSERT_TRUE(WriteErrorMapPly(dir.File("e.ply"), f.cloud, f.result, "part").ok());
+  auto cloud = ReadPointCloud(dir.File("e.ply"));
+  ASSERT_TRUE(cloud.ok()) << cloud.status();
+  ASSERT_EQ(cloud->size(), f.written_xyz.size());
+  for (std::size_t k = 0; k < cloud->size(); ++k) EXPECT_EQ(cloud->points[k], f.written_xyz[k]);
 }
 
 }  // namespace
