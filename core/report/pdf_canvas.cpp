@@ -22,9 +22,11 @@ void SetColor(cairo_t* cr, Rgb c) {
   cairo_set_source_rgb(cr, c.r / 255.0, c.g / 255.0, c.b / 255.0);
 }
 
-// Pango needs valid UTF-8: invalid bytes become U+FFFD, a NUL ends nothing.
+// Pango needs valid UTF-8 without NULs: invalid bytes and NULs become U+FFFD.
 std::string ValidUtf8(const std::string& s) {
-  gchar* valid = g_utf8_make_valid(s.data(), static_cast<gssize>(s.size()));
+  std::string no_nul;
+  for (char ch : s) no_nul += ch == '\0' ? std::string("\xEF\xBF\xBD") : std::string(1, ch);
+  gchar* valid = g_utf8_make_valid(no_nul.data(), static_cast<gssize>(no_nul.size()));
   std::string out(valid);
   g_free(valid);
   return out;

@@ -71,7 +71,8 @@ void DrawHeader(Pages& p, const PdfReportInput& in, const ReportContent& c) {
   cv.Rect(kLeft, p.y, kWidth, banner, c.pass ? kPassGreen : kFailRed);
   cv.Text(kLeft + 10, p.y + 5, c.pass ? "PASS" : "FAIL", {18, true, kWhite});
   cv.Text(kLeft + 90, p.y + 4, absl::StrCat("part verdict: ", c.verdict), {9, true, kWhite});
-  cv.Text(kLeft + 90, p.y + 17, c.reason, {7.5, false, kWhite}, kWidth - 100);
+  cv.Text(kLeft + 90, p.y + 17, absl::StrCat("all matched points: ", c.reason),
+          {7.5, false, kWhite}, kWidth - 100);
   p.y += banner + 10;
 }
 

@@ -31,10 +31,17 @@ std::string Percent(double fraction) {
   return std::isfinite(fraction) ? absl::StrFormat("%.2f %%", 100 * fraction) : "-";
 }
 
+// A member object, or an empty one when absent (its values print as "-").
+const json& Object(const json& j, const char* key) {
+  static const json kEmpty = json::object();
+  const auto it = j.find(key);
+  return it != j.end() && it->is_object() ? *it : kEmpty;
+}
+
 void AddStatistics(const json& report, ReportContent& c) {
-  const json& pts = report.at("points");
-  const json& st = report.at("statistics");
-  const json& tol = report.at("tolerance");
+  const json& pts = Object(report, "points");
+  const json& st = Object(report, "statistics");
+  const json& tol = Object(report, "tolerance");
   c.statistics = {{"points", Count(pts, "count")},
                   {"valid", Count(pts, "valid")},
                   {"matched", Count(pts, "matched")},
@@ -118,7 +125,7 @@ absl::StatusOr<ReportContent> ReportContentFromJson(const nlohmann::json& report
                                            : tol.at("verdict").get<std::string>();
     c.pass = c.verdict == "pass";
     AddStatistics(report, c);
-    ReadHistogram(report.at("histogram"), c.histogram);
+    if (report.contains("histogram")) ReadHistogram(report.at("histogram"), c.histogram);
     if (report.contains("characteristics")) AddCharacteristics(report["characteristics"], c);
     if (report.contains("defects")) AddDefects(report["defects"], c);
   } catch (const json::exception& e) {

@@ -39,7 +39,10 @@ struct ReportContent {
 std::string FormatMm(double v);
 
 // DataLoss naming the field when a required one (tolerance.band_mm,
-// color_range_mm, statistics, histogram) is missing or of the wrong type.
+// tolerance.verdict unless there is a part verdict, color_range_mm) is
+// missing, or when a field that is present has the wrong type. Missing
+// points, statistics, histogram, characteristics or defects show as "-" or
+// empty.
 absl::StatusOr<ReportContent> ReportContentFromJson(const nlohmann::json& report);
 
 }  // namespace surfinspect

@@ -191,6 +191,12 @@ TEST(PdfReport, BadInputsAreErrorsNotCrashes) {
   auto bytes = RenderPdfReport(in);
   ASSERT_TRUE(bytes.ok()) << bytes.status();
   EXPECT_EQ(bytes->substr(0, 5), "%PDF-");
+  if (HavePoppler()) {
+    TempDir out;
+    testing::WriteBytes(out.File("u.pdf"), *bytes);
+    const std::string text = Shell("pdftotext -raw '" + out.File("u.pdf") + "' -");
+    EXPECT_NE(text.find("\xEF\xBF\xBD end"), std::string::npos) << "text after the NUL is kept";
+  }
   TempDir dir;
   EXPECT_FALSE(WritePdfReport(dir.File("no/such/dir/r.pdf"), in).ok());
 }

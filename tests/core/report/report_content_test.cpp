@@ -93,8 +93,23 @@ TEST(ReportContent, DefectsStatisticsAndHistogram) {
   EXPECT_EQ(find("tolerance"), "+-0.200 mm");
 }
 
+TEST(ReportContent, OptionalSectionsMayBeMissing) {
+  nlohmann::json j = Report();
+  for (const char* key : {"histogram", "statistics", "points", "characteristics", "defects"})
+    j.erase(key);
+  auto c = ReportContentFromJson(j);
+  ASSERT_TRUE(c.ok()) << c.status();
+  EXPECT_TRUE(c->histogram.counts.empty());
+  EXPECT_TRUE(c->characteristics.rows.empty());
+  EXPECT_TRUE(c->defect_marks.empty());
+  for (const auto& [label, value] : c->statistics)
+    if (label != "tolerance" && label != "in tolerance" && label != "above/below") {
+      EXPECT_EQ(value, "-") << label;
+    }
+}
+
 TEST(ReportContent, MissingFieldsAreDataLossNamingThem) {
-  for (const char* key : {"tolerance", "color_range_mm", "histogram", "statistics", "points"}) {
+  for (const char* key : {"tolerance", "color_range_mm"}) {
     nlohmann::json j = Report();
     j.erase(key);
     auto c = ReportContentFromJson(j);
@@ -108,6 +123,13 @@ TEST(ReportContent, MissingFieldsAreDataLossNamingThem) {
   bad = Report();
   bad["defects"][0]["centroid_mm"] = "here";
   EXPECT_FALSE(ReportContentFromJson(bad).ok());
+  bad = Report();
+  bad["histogram"]["counts"] = "many";
+  EXPECT_EQ(ReportContentFromJson(bad).status().code(), absl::StatusCode::kDataLoss);
+  bad = Report();
+  bad.erase("verdict");
+  bad["tolerance"].erase("verdict");
+  EXPECT_FALSE(ReportContentFromJson(bad).ok()) << "no verdict at all";
 }
 
 TEST(ReportContent, FormatMm) {
