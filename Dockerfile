@@ -3,7 +3,8 @@
 #   build    debian:bookworm       the README's own `./run deps` + `./run build`
 #   runtime  debian:bookworm-slim  only the shared libraries the binaries link
 #                                  (tests/deploy/deploy_files_test.py checks
-#                                  the list against the built binaries)
+#                                  the list against the built binaries), and
+#                                  the font report.pdf embeds (DejaVu Sans)
 #   docker build -t surfinspect:0.1.0 .        (or: deploy/build-image.sh)
 #   docker run --rm -p 50051:50051 -p 9464:9464 surfinspect:0.1.0
 FROM debian:bookworm AS build
@@ -22,6 +23,7 @@ RUN apt-get update \
       libabsl20220623 libassimp5 libembree3-3 libfmt9 libgrpc++1.51 libgrpc29 \
       libpcl-common1.13 libpcl-io1.13 libpng16-16 libprometheus-cpp-core1.0 \
       libprometheus-cpp-pull1.0 libprotobuf32 libspdlog1.10 libssl3 libstdc++6 libtbb12 \
+      libcairo2 libglib2.0-0 libpango-1.0-0 libpangocairo-1.0-0 fonts-dejavu-core \
  && rm -rf /var/lib/apt/lists/*
 RUN useradd --system --uid 10001 --user-group --home-dir /var/lib/surfinspect --create-home \
       --shell /usr/sbin/nologin surfinspect

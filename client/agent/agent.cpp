@@ -175,6 +175,10 @@ PartReport CellAgent::InspectAndStore(const std::string& id, const std::vector<V
         id, absl::StrCat(absl::StatusCodeToString(rr.status.code()), ": ", rr.status.message()));
   } else {
     auto outputs = OutputsFromRemote(*result);
+    if (outputs.ok()) {
+      outputs->cell = cell_.name;
+      outputs->world_from_part = cell_.world_from_part;
+    }
     absl::Status written =
         outputs.ok() ? WritePartOutputs((fs::path(layout_.results) / id).string(), *outputs)
                      : outputs.status();

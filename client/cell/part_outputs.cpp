@@ -7,6 +7,8 @@
 #include "absl/strings/str_format.h"
 #include "core/errormap/error_map_output.h"
 #include "core/io/atomic_file.h"
+#include "core/report/pdf_report.h"
+#include "core/types/transform.h"
 #include "proto/convert.h"
 
 namespace surfinspect::client {
@@ -26,6 +28,20 @@ absl::Status FillFromReport(PartOutputs& o) {
     if (!(o.tolerance_mm > 0)) return absl::DataLossError("report lacks tolerance.band_mm");
   }
   return absl::OkStatus();
+}
+
+// report.pdf, its maps drawn in the part frame.
+absl::Status WritePartPdf(const std::string& path, const PartOutputs& o) {
+  const nlohmann::json report = nlohmann::json::parse(o.report_json, nullptr, false);
+  if (report.is_discarded()) return absl::DataLossError("report is not valid JSON");
+  const PointCloud in_part = TransformCloud(o.merged_in_world, o.world_from_part.inverse());
+  PdfReportInput pdf;
+  pdf.part_id = o.part_id;
+  pdf.cell = o.cell;
+  pdf.report = &report;
+  pdf.points_in_part = &in_part;
+  pdf.deviation_mm = &o.deviation_mm;
+  return WritePdfReport(path, pdf);
 }
 
 }  // namespace
@@ -117,6 +133,7 @@ absl::Status WritePartOutputs(const std::string& dir, const PartOutputs& o) {
   if (auto st = WriteErrorMapCsv(dir + "/deviations.csv", o.merged_in_world, view); !st.ok())
     return st;
   if (auto st = WriteStringAtomically(dir + "/errormap.png", o.png); !st.ok()) return st;
+  if (auto st = WritePartPdf(dir + "/report.pdf", o); !st.ok()) return st;
   // The report last: its presence means the part's results are complete.
   return WriteStringAtomically(dir + "/report.json", o.report_json);
 }

@@ -1,7 +1,8 @@
 // What an inspected part leaves on disk, the same whether it was computed
 // in-process or by surfinspectd: report.json, errormap.ply (world frame,
-// deviation + colour per point), errormap.png and deviations.csv, each
-// written atomically (temporary file, then rename).
+// deviation + colour per point), errormap.png, deviations.csv and
+// report.pdf (core/report/pdf_report.h), each written atomically
+// (temporary file, then rename).
 #pragma once
 
 #include <memory>

@@ -1,10 +1,11 @@
 // surfinspect errormap: the signed deviation of a measured cloud from the
-// CAD mesh (paper §IV) as a coloured PLY, and optionally CSV, JSON report
-// and PNG.
+// CAD mesh (paper §IV) as a coloured PLY, and optionally CSV, JSON report,
+// PNG and PDF report.
 #include <spdlog/spdlog.h>
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "client/cell/cell_config.h"
@@ -20,6 +21,7 @@
 #include "core/io/io_point_cloud.h"
 #include "core/io/io_transform.h"
 #include "core/pipeline/plan_evaluation.h"
+#include "core/report/pdf_report.h"
 #include "core/types/transform.h"
 #include "proto/convert.h"
 
@@ -27,7 +29,7 @@ namespace surfinspect::cli {
 namespace {
 
 struct ErrorMapArgs {
-  std::string cloud, mesh, world_from_part, out, csv, report, png, plan;
+  std::string cloud, mesh, world_from_part, out, csv, report, png, pdf, plan, part_id;
   std::string frame = "part";
   std::string png_axis = "auto";
   ErrorMapSettings settings;
@@ -136,9 +138,9 @@ void PrintSummary(const ErrorMapArgs& a, const ErrorMapRun& run) {
     for (const std::string& line : run.failed) std::printf("  failed %s\n", line.c_str());
     for (const std::string& line : run.defects) std::printf("  defect %s\n", line.c_str());
   }
-  std::printf("wrote %s%s%s%s%s%s%s\n", a.out.c_str(), a.csv.empty() ? "" : ", ", a.csv.c_str(),
+  std::printf("wrote %s%s%s%s%s%s%s%s%s\n", a.out.c_str(), a.csv.empty() ? "" : ", ", a.csv.c_str(),
               a.report.empty() ? "" : ", ", a.report.c_str(), a.png.empty() ? "" : ", ",
-              a.png.c_str());
+              a.png.c_str(), a.pdf.empty() ? "" : ", ", a.pdf.c_str());
 }
 
 void RunErrorMap(const ErrorMapArgs& a) {
@@ -173,6 +175,14 @@ void RunErrorMap(const ErrorMapArgs& a) {
   Check(WriteErrorMapPly(a.out, written, run.result, a.frame));
   if (!a.csv.empty()) Check(WriteErrorMapCsv(a.csv, written, run.result));
   if (!a.png.empty()) Check(WriteStringAtomically(a.png, run.png_bytes));
+  if (!a.pdf.empty()) {
+    PdfReportInput pdf;
+    pdf.part_id = a.part_id.empty() ? std::filesystem::path(a.cloud).stem().string() : a.part_id;
+    pdf.report = &run.report;
+    pdf.points_in_part = &cloud_in_part;
+    pdf.deviation_mm = &run.result.deviation_mm;
+    Check(WritePdfReport(a.pdf, pdf));
+  }
   if (!a.report.empty()) {
     // The remote report's timing is the server's; the local one is all ours.
     nlohmann::json& timing = run.report["timing"];
@@ -204,11 +214,17 @@ void AddErrorMapCommand(CLI::App& app) {
   cmd->add_option("--cloud", a->cloud, "measured cloud, world frame (.pcd/.ply)")->required();
   cmd->add_option("--mesh", a->mesh, "CAD mesh, part frame (.stl/.obj/.ply/.off)")->required();
   cmd->add_option("--world-from-part", a->world_from_part, "transform JSON (default identity)");
-  cmd->add_option("--out", a->out, "coloured binary PLY with a float 'deviation' property")
+  cmd->add_option("--out", a->out,
+                  "coloured binary PLY; the deviation as float 'scalar_deviation' (CloudCompare) "
+                  "and 'quality' (MeshLab)")
       ->required();
   cmd->add_option("--csv", a->csv, "CSV x,y,z,deviation, one row per input point");
   cmd->add_option("--report", a->report, "JSON report");
   cmd->add_option("--png", a->png, "PNG: map, colour bar, histogram, defect ids");
+  cmd->add_option("--pdf", a->pdf,
+                  "PDF report (A4): header, verdict, map views, colour bar, histogram, "
+                  "characteristics and defects");
+  cmd->add_option("--part-id", a->part_id, "the part named in the PDF (default: the cloud's stem)");
   cmd->add_option("--plan", a->plan,
                   "inspection plan JSON: regions, comparison points, defect detection "
                   "(docs/inspection-plan.md); its default band is +-tolerance");

@@ -117,9 +117,10 @@ absl::Status WriteErrorMapPly(const std::string& path, const PointCloud& points,
         "ply\nformat binary_little_endian 1.0\n",
         "comment surfinspect error map: deviation in mm, + above the CAD surface, nan unmatched\n",
         "comment frame: ", frame_name, "\nelement vertex ", points.CountValid(),
-        "\nproperty float x\nproperty float y\nproperty float z\nproperty float deviation\n"
+        "\nproperty float x\nproperty float y\nproperty float z\n"
+        "property float scalar_deviation\nproperty float quality\n"
         "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n"));
-    char record[19];
+    char record[23];
     for (std::size_t i = 0; i < points.size(); ++i) {
       const Eigen::Vector3f& p = points.points[i];
       if (!PointCloud::IsValid(p)) continue;
@@ -127,9 +128,10 @@ absl::Status WriteErrorMapPly(const std::string& path, const PointCloud& points,
       const Rgb c = DeviationColor(d, result.tolerance_mm, result.color_range_mm);
       std::memcpy(record, p.data(), 12);
       std::memcpy(record + 12, &d, 4);
-      record[16] = static_cast<char>(c.r);
-      record[17] = static_cast<char>(c.g);
-      record[18] = static_cast<char>(c.b);
+      std::memcpy(record + 16, &d, 4);
+      record[20] = static_cast<char>(c.r);
+      record[21] = static_cast<char>(c.g);
+      record[22] = static_cast<char>(c.b);
       out.Append(record, sizeof(record));
     }
     return out.Close();

@@ -1,8 +1,6 @@
-// Files an inspector opens from an error map: a coloured binary PLY (the
-// `deviation` property loads as a scalar field in CloudCompare and MeshLab),
-// a CSV with one row per input point, and a JSON report shared by the CLI
-// and the server. Every file is written atomically. The PNG picture is in
-// core/errormap/error_map_png.h.
+// Files an inspector opens from an error map: a coloured binary PLY, a CSV with one row per input
+// point, and a JSON report shared by the CLI and the server. Every file is written atomically. The
+// PNG picture is in core/errormap/error_map_png.h.
 #pragma once
 
 #include <nlohmann/json_fwd.hpp>
@@ -24,8 +22,15 @@ inline constexpr Rgb kUnmatchedGrey{150, 150, 150};
 
 // Binary little-endian PLY of the finite points of `points` (whatever frame
 // the caller chose; say it in `frame_name`, stored as a comment), each with
-// float x y z, float deviation (mm, NaN when unmatched) and uchar red green
-// blue from DeviationColor. Fails if the sizes of points and result differ.
+// float x y z, the deviation twice (float scalar_deviation and float
+// quality: mm, NaN when unmatched) and uchar red green blue from
+// DeviationColor. Fails if the sizes of points and result differ.
+// What peers load (checked with Debian's CloudCompare 2.11.3 and vcglib's
+// PLY importer): CloudCompare takes a vertex property as a scalar field only
+// when its name contains "scal", so `scalar_deviation` is its scalar field
+// "deviation" (NaN kept) and `quality` is dropped; MeshLab maps `quality` to
+// the per-vertex quality and drops `scalar_deviation`; both show red green
+// blue as the vertex colour.
 absl::Status WriteErrorMapPly(const std::string& path, const PointCloud& points,
                               const ErrorMapResult& result, const std::string& frame_name);
 

@@ -6,6 +6,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "core/errormap/error_map_output.h"
+#include "core/errormap/error_map_panel.h"
 
 namespace surfinspect {
 namespace {
@@ -13,7 +14,6 @@ namespace {
 constexpr Rgb kWhite{255, 255, 255};
 constexpr Rgb kBlack{0, 0, 0};
 constexpr uint32_t kMinMapPixels = 400;  // small grids are enlarged to at least this
-constexpr int kPanelWidth = 310;
 constexpr int kMinHeight = 520;
 
 Rgb Color(const ErrorMapResult& r, double d) {
@@ -118,18 +118,24 @@ RgbImage OrthoMap(const PointCloud& pts, const ErrorMapResult& r, const MapLayou
 }
 
 // Each defect: a black square ring (radius 7 px) around the block of the
-// valid point nearest its centroid, and its id beside it.
+// valid point nearest its centroid, and its id beside it. One pass over the
+// points finds every defect's nearest point (the first of equals).
 void DrawDefects(RgbImage& map, const PointCloud& pts, const MapLayout& l,
                  const std::vector<Defect>& defects) {
-  for (const Defect& d : defects) {
-    const Eigen::Vector3f c = d.centroid_mm.cast<float>();
-    std::size_t best = pts.size();
-    float best_d2 = INFINITY;
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-      if (!PointCloud::IsValid(pts.points[i])) continue;
-      const float d2 = (pts.points[i] - c).squaredNorm();
-      if (d2 < best_d2) best_d2 = d2, best = i;
+  std::vector<Eigen::Vector3f> centroids;
+  for (const Defect& d : defects) centroids.push_back(d.centroid_mm.cast<float>());
+  std::vector<std::size_t> nearest(defects.size(), pts.size());
+  std::vector<float> nearest_d2(defects.size(), INFINITY);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    if (!PointCloud::IsValid(pts.points[i])) continue;
+    for (std::size_t k = 0; k < centroids.size(); ++k) {
+      const float d2 = (pts.points[i] - centroids[k]).squaredNorm();
+      if (d2 < nearest_d2[k]) nearest_d2[k] = d2, nearest[k] = i;
     }
+  }
+  for (std::size_t k = 0; k < defects.size(); ++k) {
+    const Defect& d = defects[k];
+    const std::size_t best = nearest[k];
     if (best == pts.size()) continue;
     const auto [bx, by] = l.BlockOf(best, pts.points[best]);
     const int x = static_cast<int>(bx * l.zoom + l.zoom / 2);
@@ -140,60 +146,6 @@ void DrawDefects(RgbImage& map, const PointCloud& pts, const MapLayout& l,
     map.FillRect(x - kR, y - kR, 2, 2 * kR + 1, kBlack);
     map.FillRect(x + kR - 1, y - kR, 2, 2 * kR + 1, kBlack);
     map.DrawText(x + kR + 3, y - kR, absl::StrCat(d.id), kBlack, 2);
-  }
-}
-
-std::string Label(double v, double range) {
-  const int decimals = range >= 10 ? 1 : range >= 1 ? 2 : range >= 0.01 ? 3 : 4;
-  return absl::StrFormat("%+.*f", decimals, v);
-}
-
-// Verdict text, colour bar with labels, and the histogram on the same
-// vertical deviation axis, drawn at x0.
-void DrawPanel(RgbImage& img, int x0, const ErrorMapResult& r, bool pass) {
-  const Verdict& v = r.verdict;
-  img.DrawText(x0 + 10, 10, pass ? "pass" : "fail", pass ? Rgb{0, 140, 0} : Rgb{200, 0, 0}, 3);
-  const double range = r.color_range_mm;
-  img.DrawText(x0 + 10, 40, absl::StrCat("tol +-", Label(r.tolerance_mm, range).substr(1), " mm"),
-               kBlack, 2);
-  img.DrawText(x0 + 10, 58,
-               absl::StrFormat("in tol %.2f%%",
-                               100 * (std::isnan(v.fraction_within) ? 0 : v.fraction_within)),
-               kBlack, 2);
-  img.DrawText(x0 + 10, 76, absl::StrCat("rms ", Label(r.stats.rms_mm, range).substr(1), " mm"),
-               kBlack, 2);
-  img.DrawText(x0 + 10, 94, absl::StrCat("n ", r.stats.matched, "/", r.stats.valid), kBlack, 2);
-
-  const int top = 140, bottom = static_cast<int>(img.height) - 30, bar_x = x0 + 14;
-  const double span = bottom - top;
-  auto y_of = [&](double d) {
-    return top + static_cast<int>(std::lround((range - d) / (2 * range) * span));
-  };
-  img.DrawText(bar_x, top - 26, "mm", kBlack, 2);
-  img.FillRect(bar_x, top - 8, 22, 6, Color(r, 2 * range));  // beyond the scale
-  img.FillRect(bar_x, bottom + 2, 22, 6, Color(r, -2 * range));
-  for (int y = top; y < bottom; ++y)
-    img.FillRect(bar_x, y, 22, 1, Color(r, range - (y - top + 0.5) / span * 2 * range));
-  std::vector<double> ticks = {range, 0.0, -range};
-  if (r.tolerance_mm < range && y_of(r.tolerance_mm) - y_of(range) > 16 &&
-      y_of(0) - y_of(r.tolerance_mm) > 16)
-    ticks.insert(ticks.end(), {r.tolerance_mm, -r.tolerance_mm});
-  for (double t : ticks) {
-    const int y = y_of(t);
-    img.FillRect(bar_x + 22, y, 6, 1, kBlack);
-    img.DrawText(bar_x + 30, y - 7, Label(t, range), kBlack, 2);
-  }
-
-  const Histogram& h = r.histogram;
-  const int hist_x = x0 + 130, hist_w = kPanelWidth - 140;
-  const std::size_t peak =
-      h.counts.empty() ? 0 : *std::max_element(h.counts.begin(), h.counts.end());
-  img.FillRect(hist_x - 1, top, 1, bottom - top, kBlack);  // the axis
-  for (std::size_t k = 0; k < h.counts.size() && peak > 0; ++k) {
-    const double lo = h.min_mm + k * h.bin_width_mm(), hi = lo + h.bin_width_mm();
-    const int y_top = y_of(hi), y_bottom = std::max(y_of(lo), y_top + 1);
-    const int len = static_cast<int>(std::lround(static_cast<double>(h.counts[k]) / peak * hist_w));
-    img.FillRect(hist_x, y_top, len, y_bottom - y_top, Color(r, 0.5 * (lo + hi)));
   }
 }
 
@@ -208,9 +160,9 @@ int ThinnestAxis(const Bounds3& b) {
   return axis;
 }
 
-absl::StatusOr<RgbImage> RenderErrorMap(const PointCloud& points, const ErrorMapResult& result,
-                                        const Bounds3& mesh_bounds,
-                                        const ErrorMapPngOptions& options) {
+absl::StatusOr<RgbImage> RenderErrorMapView(const PointCloud& points, const ErrorMapResult& result,
+                                            const Bounds3& mesh_bounds,
+                                            const ErrorMapPngOptions& options) {
   if (result.deviation_mm.size() != points.size())
     return absl::InvalidArgumentError("error map png: result does not belong to these points");
   if (options.view_axis < -1 || options.view_axis > 2)
@@ -226,10 +178,19 @@ absl::StatusOr<RgbImage> RenderErrorMap(const PointCloud& points, const ErrorMap
   RgbImage map =
       points.organized() ? GridMap(points, result, layout) : OrthoMap(points, result, layout);
   if (options.defects) DrawDefects(map, points, layout, *options.defects);
-  RgbImage img(map.width + kPanelWidth, std::max<uint32_t>(map.height, kMinHeight), kWhite);
-  for (uint32_t y = 0; y < map.height; ++y) std::copy_n(&map.at(0, y), map.width, &img.at(0, y));
-  DrawPanel(img, static_cast<int>(map.width), result,
-            options.part_pass.value_or(result.verdict.pass));
+  return map;
+}
+
+absl::StatusOr<RgbImage> RenderErrorMap(const PointCloud& points, const ErrorMapResult& result,
+                                        const Bounds3& mesh_bounds,
+                                        const ErrorMapPngOptions& options) {
+  auto map = RenderErrorMapView(points, result, mesh_bounds, options);
+  if (!map.ok()) return map.status();
+  RgbImage img(map->width + kPanelWidth, std::max<uint32_t>(map->height, kMinHeight), kWhite);
+  for (uint32_t y = 0; y < map->height; ++y) std::copy_n(&map->at(0, y), map->width, &img.at(0, y));
+  DrawErrorMapPanel(
+      img, MakePanelLayout(static_cast<int>(map->width), img.height, result.color_range_mm), result,
+      options.part_pass.value_or(result.verdict.pass));
   return img;
 }
 

@@ -1,10 +1,11 @@
-// The error-map picture (paper Fig. 11): the coloured map, a colour bar with
-// mm labels at +-range, +-tolerance and 0, the histogram beside it on the
-// same deviation axis, and the verdict. An organized cloud is drawn in its
-// sensor grid; a merged (unorganized) cloud as an orthographic view along an
-// axis, by default the CAD's thinnest extent (a sheet-metal part seen from
-// above), nearest point per pixel. Defects, when given, are marked on the map
-// by a ring at the drawn point nearest their centroid and their id.
+// The error-map picture (paper Fig. 11): the coloured map, and beside it the
+// panel of core/errormap/error_map_panel.h (verdict, colour bar with the
+// tolerance band bracketed, log-count histogram on the same deviation
+// axis). An organized cloud is drawn in its sensor grid; a merged
+// (unorganized) cloud as an orthographic view along an axis, by default the
+// CAD's thinnest extent (a sheet-metal part seen from above), nearest point
+// per pixel. Defects, when given, are marked on the map by a ring at the
+// drawn point nearest their centroid and their id beside it.
 #pragma once
 
 #include <optional>
@@ -38,6 +39,12 @@ int ThinnestAxis(const Bounds3& b);
 absl::StatusOr<RgbImage> RenderErrorMap(const PointCloud& points, const ErrorMapResult& result,
                                         const Bounds3& mesh_bounds,
                                         const ErrorMapPngOptions& options = {});
+
+// The map alone, without the panel (for reports that draw their own colour
+// bar): the same raster RenderErrorMap puts at its left edge.
+absl::StatusOr<RgbImage> RenderErrorMapView(const PointCloud& points, const ErrorMapResult& result,
+                                            const Bounds3& mesh_bounds,
+                                            const ErrorMapPngOptions& options = {});
 
 // RenderErrorMap, then WritePng (atomic).
 absl::Status WriteErrorMapPng(const std::string& path, const PointCloud& points,

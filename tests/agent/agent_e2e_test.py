@@ -64,7 +64,7 @@ def read_ply(path):
     end = data.index(b"end_header\n") + len(b"end_header\n")
     header = data[:end].decode()
     n = int([l for l in header.splitlines() if l.startswith("element vertex")][0].split()[2])
-    rec = struct.Struct("<4f3B")
+    rec = struct.Struct("<5f3B")  # x y z scalar_deviation quality red green blue
     return [rec.unpack_from(data, end + i * rec.size)[:4] for i in range(n)]
 
 

@@ -39,7 +39,7 @@ if(NOT report MATCHES "\"verdict\": \"fail\"" OR NOT report MATCHES "\"matched\"
 endif()
 file(READ ${WORK}/o.ply ply LIMIT 400)
 if(NOT ply MATCHES "^ply\nformat binary_little_endian 1.0" OR NOT ply MATCHES "element vertex 5"
-   OR NOT ply MATCHES "property float deviation")
+   OR NOT ply MATCHES "property float scalar_deviation\nproperty float quality\n")
   message(FATAL_ERROR "PLY header wrong:\n${ply}")
 endif()
 file(READ ${WORK}/o.png png LIMIT 4 HEX)

@@ -348,25 +348,26 @@ TEST(ErrorMapOutput, PlyHoldsValidPointsDeviationAndColour) {
     if (line.rfind("element vertex ", 0) == 0) vertices = std::stoul(line.substr(15));
   }
   EXPECT_NE(header.find("format binary_little_endian 1.0"), std::string::npos);
-  EXPECT_NE(header.find("property float deviation\nproperty uchar red\nproperty uchar green\n"
-                        "property uchar blue"),
+  EXPECT_NE(header.find("property float scalar_deviation\nproperty float quality\n"
+                        "property uchar red\nproperty uchar green\nproperty uchar blue"),
             std::string::npos);
   EXPECT_NE(header.find("comment frame: part"), std::string::npos);
   ASSERT_EQ(vertices, f.cloud.CountValid());
   std::size_t k = 0;
   for (std::size_t i = 0; i < f.cloud.size(); ++i) {
     if (!PointCloud::IsValid(f.cloud.points[i])) continue;
-    char rec[19];
-    ASSERT_TRUE(in.read(rec, 19)) << k;
-    float xyzd[4];
-    std::memcpy(xyzd, rec, 16);
+    char rec[23];
+    ASSERT_TRUE(in.read(rec, 23)) << k;
+    float xyzd[5];
+    std::memcpy(xyzd, rec, 20);
     EXPECT_EQ(xyzd[0], f.cloud.points[i].x());
     EXPECT_EQ(xyzd[2], f.cloud.points[i].z());
     const float d = f.result.deviation_mm[i];
     EXPECT_TRUE(std::isnan(d) ? std::isnan(xyzd[3]) : xyzd[3] == d);
+    EXPECT_TRUE(std::isnan(d) ? std::isnan(xyzd[4]) : xyzd[4] == d);
     const Rgb c = DeviationColor(d, f.result.tolerance_mm, f.result.color_range_mm);
-    EXPECT_EQ(static_cast<uint8_t>(rec[16]), c.r);
-    EXPECT_EQ(static_cast<uint8_t>(rec[18]), c.b);
+    EXPECT_EQ(static_cast<uint8_t>(rec[20]), c.r);
+    EXPECT_EQ(static_cast<uint8_t>(rec[22]), c.b);
     ++k;
   }
   EXPECT_EQ(in.peek(), EOF) << "no trailing bytes";
