@@ -61,10 +61,10 @@ std::string HistogramSvg(const nlohmann::json& report, const DeviationPalette& p
                           kHeight - 6, mm);
   }
   absl::StrAppendFormat(&out,
-                        "<text x=\"2\" y=\"%.2f\">log</text><text x=\"2\" y=\"%.2f\">%.0f</text>"
-                        "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"end\">below %s, above %s</text>"
-                        "\n</svg>\n",
-                        kTop + plot_h / 2, kTop + 10, std::pow(10, top) - 1, kWidth - 4, kTop + 10,
+                        "<text x=\"2\" y=\"%.2f\">log</text>"
+                        "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"end\">tallest bin %.0f; "
+                        "below the range %s, above %s</text>\n</svg>\n",
+                        kTop + plot_h / 2, kWidth - 4, kTop + 10, std::pow(10, top) - 1,
                         HtmlEscape(h.value("below_range", nlohmann::json(0)).dump()),
                         HtmlEscape(h.value("above_range", nlohmann::json(0)).dump()));
   return out;

@@ -85,6 +85,7 @@ absl::StatusOr<HtmlPayload> BuildHtmlPayload(const PointCloud& points_in_part,
   const ThinningResult thin = ThinOnGrid(all.xyz, priority, settings.max_points);
   out.thinned = thin.level >= 0;
   if (out.thinned) out.cell_mm = std::ldexp(all.step.maxCoeff(), thin.level);
+  out.per_cell = thin.per_cell;
   std::vector<Eigen::Vector3f> shown_xyz;
   shown_xyz.reserve(thin.kept.size());
   for (uint32_t j : thin.kept) {

@@ -56,6 +56,7 @@ struct HtmlPayload {
   std::size_t input_points = 0;  // all of them, NaN coordinates included
   std::size_t finite_points = 0;
   bool thinned = false;
+  int per_cell = 0;              // points kept per cell, largest |deviation| first
   double cell_mm = 0;            // largest edge of the thinning cell (0 unthinned)
   std::vector<uint32_t> source;  // input index of each shown point
   QuantisedPositions positions;

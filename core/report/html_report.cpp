@@ -47,6 +47,7 @@ json ViewerData(const json& report, const HtmlReportContext& ctx, const Deviatio
                     {"shown", p.positions.size()},
                     {"thinned", p.thinned},
                     {"cell_mm", p.cell_mm},
+                    {"per_cell", p.per_cell},
                     {"min", Vec(p.positions.min)},
                     {"step", Vec(p.positions.step)},
                     {"deviation_step_mm", p.deviation_step_mm},

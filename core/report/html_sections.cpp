@@ -42,7 +42,11 @@ std::string ValueRow(const std::string& label, const std::string& key, const jso
 }
 
 std::string Band(const json& tolerance) {
-  return absl::StrFormat("[%s, %s]", Text(At(tolerance, "lower")), Text(At(tolerance, "upper")));
+  const auto bound = [&](const char* key) {
+    const double v = Num(tolerance, key);
+    return std::isnan(v) ? std::string("\u2013") : absl::StrFormat("%g", v);
+  };
+  return absl::StrCat(bound("lower"), " .. ", bound("upper"));
 }
 
 std::string Verdict(const json& v) {

@@ -214,10 +214,32 @@ def run(cmd, **kw):
     return r.stdout
 
 
+def calibrate(bin_dir, cell, work):
+    """cell-agent calibrate against a surfinspectd started here on loopback."""
+    log = open(os.path.join(work, "surfinspectd.log"), "w")
+    server = subprocess.Popen([os.path.join(bin_dir, "surfinspectd"), "--listen", "127.0.0.1:0"],
+                              stdout=subprocess.PIPE, stderr=log, text=True)
+    try:
+        target = None
+        for line in server.stdout:
+            m = re.match(r"surfinspectd listening on (\S+)", line)
+            if m:
+                target = m.group(1)
+                break
+        if not target:
+            fail("surfinspectd did not start (see %s)" % log.name)
+        run([os.path.join(bin_dir, "cell-agent"), "calibrate", "--cell", cell, "--server", target])
+    finally:
+        server.terminate()
+        server.wait(10)
+        log.close()
+
+
 def make_part(bin_dir, work):
     si = os.path.join(bin_dir, "surfinspect")
     run([si, "demo-cell", "--out", os.path.join(work, "cell"), "--parts", "1"])
     cell = os.path.join(work, "cell", "cell.json")
+    calibrate(bin_dir, cell, work)
     scans = sorted(os.listdir(os.path.join(work, "cell", "scans")))[0]
     out = os.path.join(work, "results", scans)
     run([si, "inspect", "--cell", cell, "--scans", os.path.join(work, "cell", "scans", scans),
@@ -311,7 +333,7 @@ def main():
             fail("the page did not become ready in 30 s; errors: %s" % dt.errors)
         state = dt.eval("window.surfinspect")
         print("time to interactive: %.0f ms (page's own clock from navigation start); %.2f s wall "
-              "from Page.navigate" % (state["tti_ms"], wall), flush=True)
+              "from Page.navigate; page marks (ms): %s" % (state["tti_ms"], wall, state["timings"]), flush=True)
         dt.pump(0.5)
         checks(dt, shots, report, state)
     finally:

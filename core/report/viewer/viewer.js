@@ -8,7 +8,9 @@
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 
-const state = { ready: false, errors: [], shown: 0, tti_ms: null, views: 0, picks: 0 };
+const state = { ready: false, errors: [], shown: 0, tti_ms: null, views: 0, picks: 0, timings: {} };
+const mark = (name) => { state.timings[name] = Math.round(performance.now()); };
+mark('module');
 window.surfinspect = state;
 window.addEventListener('error', (e) => state.errors.push(String(e.message)));
 
@@ -64,7 +66,7 @@ function buildPoints(bytes, centre) {
   geometry.computeBoundingSphere();
   const ext = P.step.map((s) => s * 65535).sort((a, b) => b - a);
   const spacing = Math.sqrt(Math.max(ext[0] * ext[1], 1e-6) / Math.max(P.shown, 1));
-  const material = new THREE.PointsMaterial({ size: 1.6 * spacing, vertexColors: true });
+  const material = new THREE.PointsMaterial({ size: 2 * spacing, vertexColors: true });
   const points = new THREE.Points(geometry, material);
   points.userData.deviations = typed(bytes, P.deviations, Int16Array);
   points.userData.spacing = spacing;
@@ -78,9 +80,9 @@ function buildMesh(bytes, centre) {
   const q = typed(bytes, M.positions, Uint16Array);
   geometry.setAttribute('position', new THREE.BufferAttribute(dequantise(q, M.min, M.step, centre), 3));
   geometry.setIndex(new THREE.BufferAttribute(typed(bytes, M.indices, Uint32Array), 1));
-  geometry.computeVertexNormals();
-  const material = new THREE.MeshLambertMaterial({
-    color: 0xb8c4d0, transparent: true, opacity: 0.18, depthWrite: false, side: THREE.DoubleSide,
+  // Unlit: one cheap shader program less to compile before the first frame.
+  const material = new THREE.MeshBasicMaterial({
+    color: 0xb8c4d0, transparent: true, opacity: 0.16, depthWrite: false, side: THREE.DoubleSide,
   });
   return new THREE.Mesh(geometry, material);
 }
@@ -123,8 +125,8 @@ function main() {
   const note = document.getElementById('viewer-note');
   const P = data.points;
   note.textContent = `${P.shown.toLocaleString('en')} of ${P.finite.toLocaleString('en')} points shown` +
-    (P.thinned ? ` (thinned on a grid of ${P.cell_mm.toPrecision(3)} mm cells, largest |deviation| kept;` +
-      ' statistics are over all points)' : '') +
+    (P.thinned ? ` (thinned on a grid: up to ${P.per_cell} per ${P.cell_mm.toPrecision(3)} mm cell, ` +
+      'largest |deviation| first; the statistics are over all points)' : '') +
     (data.mesh_omitted ? '; the CAD mesh is too large to embed' : '');
   drawLegend(document.getElementById('legend'));
   if (P.shown === 0) { state.ready = true; state.tti_ms = performance.now(); return; }
@@ -134,15 +136,16 @@ function main() {
   renderer.setPixelRatio(window.devicePixelRatio || 1);
   renderer.domElement.classList.add('gl');
   viewer.prepend(renderer.domElement);
-  const bytes = decodeBase64(document.getElementById('si-payload').textContent.trim());
+  const bytes = decodeBase64(document.getElementById('si-payload').textContent);
+  mark('decoded');
   const centre = [0, 1, 2].map((a) => P.min[a] + P.step[a] * 32767.5);
   const scene = new THREE.Scene();
   scene.background = new THREE.Color(0x20242a);
-  scene.add(new THREE.HemisphereLight(0xffffff, 0x667788, 2.5));
   const points = buildPoints(bytes, centre);
   scene.add(points);
   const mesh = buildMesh(bytes, centre);
   if (mesh) scene.add(mesh);
+  mark('built');
   const radius = points.geometry.boundingSphere.radius || 1;
   const camera = new THREE.PerspectiveCamera(35, 1, radius / 1000, radius * 20);
   camera.up.set(0, 0, 1);
@@ -159,6 +162,14 @@ function main() {
   };
   new ResizeObserver(resize).observe(viewer);
   resize();
+  mark('rendered');
+  // For benchmarks: one frame drawn to completion, ms.
+  state.frame_ms = () => {
+    const t = performance.now();
+    render(view);
+    renderer.getContext().finish();
+    return performance.now() - t;
+  };
   state.shown = P.shown;
   state.ready = true;
   state.tti_ms = performance.now();
