@@ -66,12 +66,13 @@ json ViewerData(const json& report, const HtmlReportContext& ctx, const Deviatio
   data["defects"] = json::array();
   if (report.contains("defects") && report["defects"].is_array())
     for (const json& d : report["defects"])
-      data["defects"].push_back({{"id", d.value("id", json())},
-                                 {"kind", d.value("kind", json())},
-                                 {"centroid_mm", d.value("centroid_mm", json())},
-                                 {"extent_mm", d.value("extent_mm", json())},
-                                 {"peak_mm", d.value("peak_mm", json())},
-                                 {"region", d.value("region", json())}});
+      if (d.is_object())
+        data["defects"].push_back({{"id", d.value("id", json())},
+                                   {"kind", d.value("kind", json())},
+                                   {"centroid_mm", d.value("centroid_mm", json())},
+                                   {"extent_mm", d.value("extent_mm", json())},
+                                   {"peak_mm", d.value("peak_mm", json())},
+                                   {"region", d.value("region", json())}});
   return data;
 }
 
@@ -85,7 +86,9 @@ std::string Head(const HtmlReportContext& ctx, const json& report) {
       {"imports",
        {{"three", DataUrl(a.three_module_base64)},
         {"three/addons/controls/OrbitControls.js", DataUrl(a.orbit_controls_base64)}}}};
-  const std::string verdict = report.value("verdict", std::string("?"));
+  const std::string verdict = report.contains("verdict") && report["verdict"].is_string()
+                                  ? report["verdict"].get<std::string>()
+                                  : "?";
   return absl::StrCat("<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n",
                       "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n",
                       "<title>surfinspect report: ", HtmlEscape(ctx.part_id), " (",
@@ -132,10 +135,7 @@ absl::Status CheckInput(const HtmlReportInput& in) {
   return absl::OkStatus();
 }
 
-}  // namespace
-
-absl::StatusOr<HtmlReportPage> BuildHtmlReport(const HtmlReportInput& in) {
-  if (auto st = CheckInput(in); !st.ok()) return st;
+absl::StatusOr<HtmlReportPage> BuildPage(const HtmlReportInput& in) {
   const json& report = *in.report;
   const auto t0 = std::chrono::steady_clock::now();
   const DeviationPalette palette = MakeDeviationPalette(
@@ -159,6 +159,17 @@ absl::StatusOr<HtmlReportPage> BuildHtmlReport(const HtmlReportInput& in) {
       "</script>\n<script type=\"module\" src=\"", DataUrl(GetViewerAssets().viewer_base64),
       "\"></script>\n</body></html>\n");
   return page;
+}
+
+}  // namespace
+
+absl::StatusOr<HtmlReportPage> BuildHtmlReport(const HtmlReportInput& in) {
+  if (auto st = CheckInput(in); !st.ok()) return st;
+  try {
+    return BuildPage(in);
+  } catch (const json::exception& e) {  // a report field of an unexpected type
+    return absl::InvalidArgumentError(absl::StrCat("HTML report: malformed report: ", e.what()));
+  }
 }
 
 absl::Status WriteHtmlReport(const std::string& path, const HtmlReportInput& input) {

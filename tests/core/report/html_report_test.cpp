@@ -186,6 +186,16 @@ TEST(HtmlReport, RefusesIncompleteInput) {
   EXPECT_EQ(Page(no_band, p).status().code(), absl::StatusCode::kInvalidArgument);
   HtmlReportInput in;
   EXPECT_EQ(BuildHtmlReport(in).status().code(), absl::StatusCode::kInvalidArgument);
+  // Fields of unexpected types are shown as they are or left out, never a crash.
+  json odd = Report();
+  odd["verdict"] = 3;
+  odd["histogram"] = "none";
+  odd["defects"] = {1, "two", nullptr};
+  odd["characteristics"] = 5;
+  odd["statistics"] = nullptr;
+  auto page = Page(odd, p);
+  ASSERT_TRUE(page.ok()) << page.status();
+  EXPECT_NE(page->html.find("no histogram"), std::string::npos);
 }
 
 TEST(HtmlReport, WritesTheFile) {
