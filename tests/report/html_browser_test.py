@@ -22,6 +22,7 @@ import struct
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 import urllib.request
 import zlib
@@ -266,14 +267,13 @@ def start_chromium(chromium, profile):
         proc.kill()
         fail("chromium did not start its DevTools endpoint")
     # Keep draining stderr so chromium never blocks on a full pipe.
-    import threading
     threading.Thread(target=lambda: [None for _ in proc.stderr], daemon=True).start()
     targets = json.load(urllib.request.urlopen("http://127.0.0.1:%d/json/list" % port, timeout=10))
     page = [t for t in targets if t.get("type") == "page"][0]
     return proc, page["webSocketDebuggerUrl"]
 
 
-def check_drawn(dt, shots, report_dir, tag):
+def check_drawn(dt, shots, tag):
     canvas = rect_of(dt, "#viewer canvas.gl")
     legend = rect_of(dt, "#legend")
     path = os.path.join(shots, "report_html_%s.png" % tag)
@@ -332,8 +332,14 @@ def main():
         if not ready:
             fail("the page did not become ready in 30 s; errors: %s" % dt.errors)
         state = dt.eval("window.surfinspect")
-        print("time to interactive: %.0f ms (page's own clock from navigation start); %.2f s wall "
-              "from Page.navigate; page marks (ms): %s" % (state["tti_ms"], wall, state["timings"]), flush=True)
+        print("time to interactive: %.0f ms (page's own clock from navigation start; goal 3000 ms: "
+              "%s); %.2f s wall from Page.navigate; page marks (ms): %s; load average %.1f" %
+              (state["tti_ms"], "met" if state["tti_ms"] <= 3000 else "NOT met", wall,
+               state["timings"], os.getloadavg()[0]), flush=True)
+        # The 3 s goal is reported, not enforced: the machine is shared. Far
+        # beyond it something is wrong.
+        if state["tti_ms"] > 20000:
+            fail("time to interactive %.0f ms" % state["tti_ms"])
         dt.pump(0.5)
         checks(dt, shots, report, state)
     finally:
@@ -354,7 +360,7 @@ def checks(dt, shots, report, state):
         fail("shown points %s (valid %d, cap 1 M)" % (state["shown"], shown))
 
     # 1. drawn: background share, palette colours on the map and on the legend
-    path1, view, leg = check_drawn(dt, shots, None, "1_iso")
+    path1, view, leg = check_drawn(dt, shots, "1_iso")
     drawn = sum(1 for p in view if not near(p, BACKGROUND, 6)) / len(view)
     coloured = sum(1 for p in view if any(near(p, c, 3) for c in colours[2:255])) / len(view)
     print("screenshot %s: %.1f%% of the canvas drawn, %.1f%% in palette colours" %
@@ -378,7 +384,7 @@ def checks(dt, shots, report, state):
     dt.pump(1.0)
     if not dt.eval("document.querySelector('tr.defect[data-defect=\"1\"]').classList.contains('selected')"):
         fail("the clicked defect row is not selected")
-    path2, view2, _ = check_drawn(dt, shots, None, "2_defect1")
+    path2, view2, _ = check_drawn(dt, shots, "2_defect1")
     changed = sum(1 for a, b in zip(view, view2) if not near(a, b, 8)) / len(view)
     print("screenshot %s: %.1f%% of the canvas changed after the click on defect 1" %
           (path2, 100 * changed), flush=True)
@@ -405,7 +411,7 @@ def checks(dt, shots, report, state):
     top = rect_of(dt, 'button[data-view="top"]')
     dt.click(top["x"] + top["width"] / 2, top["y"] + top["height"] / 2)
     dt.pump(1.0)
-    path3, view3, _ = check_drawn(dt, shots, None, "3_top")
+    path3, view3, _ = check_drawn(dt, shots, "3_top")
     changed = sum(1 for a, b in zip(view2, view3) if not near(a, b, 8)) / len(view2)
     print("screenshot %s: %.1f%% of the canvas changed after the 'top' button" % (path3, 100 * changed), flush=True)
     if changed < 0.05:
