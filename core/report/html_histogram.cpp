@@ -11,7 +11,7 @@
 namespace surfinspect {
 namespace {
 
-constexpr double kWidth = 420, kHeight = 180, kLeft = 34, kBottom = 22, kTop = 6;
+constexpr double kWidth = 420, kHeight = 190, kLeft = 34, kBottom = 22, kTop = 16;
 
 std::string Hex(Rgb c) { return absl::StrFormat("#%02x%02x%02x", c.r, c.g, c.b); }
 
@@ -70,7 +70,7 @@ std::string HistogramSvg(const nlohmann::json& report, const DeviationPalette& p
       "<text x=\"2\" y=\"%.2f\">log</text>"
       "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"end\">tallest bin %.0f; "
       "below the range %s, above %s</text>\n</svg>\n",
-      kTop + plot_h / 2, kWidth - 4, kTop + 10, std::pow(10, top) - 1,
+      kTop + plot_h / 2, kWidth - 4, kTop - 5, std::pow(10, top) - 1,
       HtmlEscape(h.value("below_range", nlohmann::json(0))
                      .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)),
       HtmlEscape(h.value("above_range", nlohmann::json(0))

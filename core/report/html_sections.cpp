@@ -41,12 +41,14 @@ std::string ValueRow(const std::string& label, const std::string& key, const jso
                       "</td></tr>\n");
 }
 
+// "+-t" for a symmetric band, "lower..upper" otherwise (mm).
 std::string Band(const json& tolerance) {
-  const auto bound = [&](const char* key) {
-    const double v = Num(tolerance, key);
+  const double lo = Num(tolerance, "lower"), hi = Num(tolerance, "upper");
+  if (lo == -hi) return absl::StrFormat("\u00b1%g", hi);
+  const auto bound = [](double v) {
     return std::isnan(v) ? std::string("\u2013") : absl::StrFormat("%g", v);
   };
-  return absl::StrCat(bound("lower"), " .. ", bound("upper"));
+  return absl::StrCat(bound(lo), "..", bound(hi));
 }
 
 std::string Verdict(const json& v) {
@@ -89,7 +91,7 @@ std::string CharacteristicsTable(const json& report) {
                     Td(At(c, "name")), Td(At(c, "type")), Verdict(At(c, "verdict")),
                     Td(Band(At(c, "tolerance_mm"))), Td(value), Td(At(c, "min_mm")),
                     Td(At(c, "max_mm")),
-                    Td(std::isnan(within) ? json() : json(absl::StrFormat("%.3f%%", 100 * within))),
+                    Td(std::isnan(within) ? json() : json(absl::StrFormat("%.2f%%", 100 * within))),
                     Td(At(c, "points")), "</tr>\n");
   }
   return out + "</tbody></table>\n";
