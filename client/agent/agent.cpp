@@ -5,6 +5,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "client/cell/part_outputs.h"
+#include "client/cell/report_context.h"
+#include "core/io/io_mesh.h"
 #include "core/io/io_point_cloud.h"
 
 namespace surfinspect::client {
@@ -111,6 +113,15 @@ PartReport CellAgent::QuarantinePart(const std::string& id, const std::string& w
   return Report(PartOutcome::kQuarantined, why);
 }
 
+std::shared_ptr<const TriangleMesh> CellAgent::PartMesh() {
+  if (!part_mesh_read_) {
+    part_mesh_read_ = true;
+    if (auto mesh = ReadMesh(cell_.part_mesh); mesh.ok())
+      part_mesh_ = std::make_shared<const TriangleMesh>(*std::move(mesh));
+  }
+  return part_mesh_;
+}
+
 void CellAgent::TellStored(const std::string& id) const {
   const std::string dir = (fs::path(layout_.results) / id).string();
   for (const auto& listener : hooks_.on_stored) listener(id, dir);
@@ -178,6 +189,8 @@ PartReport CellAgent::InspectAndStore(const std::string& id, const std::vector<V
     if (outputs.ok()) {
       outputs->cell = cell_.name;
       outputs->world_from_part = cell_.world_from_part;
+      outputs->mesh_in_part = PartMesh();
+      outputs->viewpoints = ViewpointCalibrations(cell_);
     }
     absl::Status written =
         outputs.ok() ? WritePartOutputs((fs::path(layout_.results) / id).string(), *outputs)

@@ -16,6 +16,7 @@
 #include <atomic>
 #include <functional>
 #include <map>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -116,6 +117,9 @@ class CellAgent {
   PartReport InspectAndStore(const std::string& id, const std::vector<ViewScan>& views,
                              const std::atomic<bool>& stop);
   void TellStored(const std::string& id) const;
+  // The part's CAD mesh for the reports' overlay, read once on first use;
+  // null when it cannot be read (the reports then go without the overlay).
+  std::shared_ptr<const TriangleMesh> PartMesh();
 
   const CellConfig& cell_;
   InboxLayout layout_;
@@ -124,6 +128,8 @@ class CellAgent {
   std::mt19937_64 rng_;
   // Parts judged for quarantine whose move failed: id -> reason.
   std::map<std::string, std::string> quarantine_pending_;
+  std::shared_ptr<const TriangleMesh> part_mesh_;
+  bool part_mesh_read_ = false;
 };
 
 }  // namespace surfinspect::client

@@ -7,6 +7,7 @@
 #include "absl/strings/str_format.h"
 #include "core/errormap/error_map_output.h"
 #include "core/io/atomic_file.h"
+#include "core/report/html_report.h"
 #include "core/report/pdf_report.h"
 #include "core/types/transform.h"
 #include "proto/convert.h"
@@ -44,6 +45,20 @@ absl::Status WritePartPdf(const std::string& path, const PartOutputs& o) {
   return WritePdfReport(path, pdf);
 }
 
+// report.html: the merged points in the part frame, so they overlay the CAD.
+absl::Status WriteReportHtml(const std::string& path, const PartOutputs& o) {
+  const nlohmann::json report = nlohmann::json::parse(o.report_json, nullptr, false);
+  if (report.is_discarded()) return absl::DataLossError("report is not valid JSON");
+  const PointCloud in_part = TransformCloud(o.merged_in_world, o.world_from_part.inverse());
+  HtmlReportInput in;
+  in.report = &report;
+  in.points_in_part = &in_part;
+  in.deviation_mm = &o.deviation_mm;
+  in.mesh_in_part = o.mesh_in_part.get();
+  in.context = {o.part_id, o.cell, o.viewpoints};
+  return WriteHtmlReport(path, in);
+}
+
 }  // namespace
 
 std::vector<std::string> FailedLines(const CharacteristicsResult& characteristics) {
@@ -69,6 +84,7 @@ absl::StatusOr<PartOutputs> OutputsFromLocal(const std::string& part_id, const I
                                              const TriangleMesh& part) {
   PartOutputs o;
   o.part_id = part_id;
+  o.world_from_part = world_from_part;
   o.verdict = r.plan.pass() ? "pass" : "fail";
   o.report_json = ErrorMapReportText(r.error_map, settings.error_map, r.plan);
   auto png = ErrorMapPngBytes(r.merged.cloud_in_world, world_from_part, r.error_map, part, r.plan);
@@ -134,6 +150,7 @@ absl::Status WritePartOutputs(const std::string& dir, const PartOutputs& o) {
     return st;
   if (auto st = WriteStringAtomically(dir + "/errormap.png", o.png); !st.ok()) return st;
   if (auto st = WritePartPdf(dir + "/report.pdf", o); !st.ok()) return st;
+  if (auto st = WriteReportHtml(dir + "/report.html", o); !st.ok()) return st;
   // The report last: its presence means the part's results are complete.
   return WriteStringAtomically(dir + "/report.json", o.report_json);
 }

@@ -1,7 +1,8 @@
 // What an inspected part leaves on disk, the same whether it was computed
 // in-process or by surfinspectd: report.json, errormap.ply (world frame,
 // deviation + colour per point), errormap.png, deviations.csv and
-// report.pdf (core/report/pdf_report.h), each written atomically
+// report.pdf (core/report/pdf_report.h) and report.html
+// (core/report/html_report.h, part frame), each written atomically
 // (temporary file, then rename).
 #pragma once
 
@@ -11,6 +12,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/pipeline/inspection.h"
+#include "core/report/html_sections.h"
 #include "core/types/point_cloud.h"
 #include "surfinspect/v1/inspection.pb.h"
 
@@ -33,6 +35,7 @@ struct PartOutputs {
   std::string cell;
   Eigen::Isometry3d world_from_part = Eigen::Isometry3d::Identity();
   std::shared_ptr<const TriangleMesh> mesh_in_part;
+  std::vector<ViewpointCalibration> viewpoints;  // calibration status; empty: not known
 };
 
 // The lines of PartOutputs::failed and ::defects.

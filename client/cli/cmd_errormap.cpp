@@ -21,6 +21,7 @@
 #include "core/io/io_point_cloud.h"
 #include "core/io/io_transform.h"
 #include "core/pipeline/plan_evaluation.h"
+#include "core/report/html_report.h"
 #include "core/report/pdf_report.h"
 #include "core/types/transform.h"
 #include "proto/convert.h"
@@ -29,7 +30,7 @@ namespace surfinspect::cli {
 namespace {
 
 struct ErrorMapArgs {
-  std::string cloud, mesh, world_from_part, out, csv, report, png, pdf, plan, part_id;
+  std::string cloud, mesh, world_from_part, out, csv, report, png, pdf, plan, part_id, html;
   std::string frame = "part";
   std::string png_axis = "auto";
   ErrorMapSettings settings;
@@ -138,9 +139,25 @@ void PrintSummary(const ErrorMapArgs& a, const ErrorMapRun& run) {
     for (const std::string& line : run.failed) std::printf("  failed %s\n", line.c_str());
     for (const std::string& line : run.defects) std::printf("  defect %s\n", line.c_str());
   }
-  std::printf("wrote %s%s%s%s%s%s%s%s%s\n", a.out.c_str(), a.csv.empty() ? "" : ", ", a.csv.c_str(),
-              a.report.empty() ? "" : ", ", a.report.c_str(), a.png.empty() ? "" : ", ",
-              a.png.c_str(), a.pdf.empty() ? "" : ", ", a.pdf.c_str());
+  std::printf("wrote %s%s%s%s%s%s%s%s%s%s%s\n", a.out.c_str(), a.csv.empty() ? "" : ", ",
+              a.csv.c_str(), a.report.empty() ? "" : ", ", a.report.c_str(),
+              a.png.empty() ? "" : ", ", a.png.c_str(), a.pdf.empty() ? "" : ", ", a.pdf.c_str(),
+              a.html.empty() ? "" : ", ", a.html.c_str());
+}
+
+// report.html: the report with its inputs, the points in the part frame,
+// the mesh as the overlay; the part is named after the cloud file.
+void WriteHtml(const ErrorMapArgs& a, const ErrorMapRun& run, const PointCloud& cloud_in_part,
+               const TriangleMesh& mesh) {
+  nlohmann::json report = run.report;
+  report["inputs"] = {{"cloud", a.cloud}, {"mesh", a.mesh}, {"world_from_part", a.world_from_part}};
+  HtmlReportInput in;
+  in.report = &report;
+  in.points_in_part = &cloud_in_part;
+  in.deviation_mm = &run.result.deviation_mm;
+  in.mesh_in_part = &mesh;
+  in.context.part_id = std::filesystem::path(a.cloud).stem().string();
+  Check(WriteHtmlReport(a.html, in));
 }
 
 void RunErrorMap(const ErrorMapArgs& a) {
@@ -165,6 +182,7 @@ void RunErrorMap(const ErrorMapArgs& a) {
                                     {"nonmanifold_edges", topo.nonmanifold_edges},
                                     {"degenerate_triangles", mesh.CountDegenerate()}};
   const PointCloud cloud_in_part = TransformCloud(cloud_in_world, world_from_part.inverse());
+  const TriangleMesh html_mesh = a.html.empty() ? TriangleMesh() : mesh;  // the local path takes it
   ErrorMapRun run = a.remote.remote()
                         ? RemoteErrorMap(a, cloud_in_world, world_from_part, mesh, plan)
                         : LocalErrorMap(a, cloud_in_world, cloud_in_part, world_from_part,
@@ -183,6 +201,7 @@ void RunErrorMap(const ErrorMapArgs& a) {
     pdf.deviation_mm = &run.result.deviation_mm;
     Check(WritePdfReport(a.pdf, pdf));
   }
+  if (!a.html.empty()) WriteHtml(a, run, cloud_in_part, html_mesh);
   if (!a.report.empty()) {
     // The remote report's timing is the server's; the local one is all ours.
     nlohmann::json& timing = run.report["timing"];
@@ -225,6 +244,8 @@ void AddErrorMapCommand(CLI::App& app) {
                   "PDF report (A4): header, verdict, map views, colour bar, histogram, "
                   "characteristics and defects");
   cmd->add_option("--part-id", a->part_id, "the part named in the PDF (default: the cloud's stem)");
+  cmd->add_option("--html", a->html,
+                  "self-contained interactive report (3D view, tables, histogram), part frame");
   cmd->add_option("--plan", a->plan,
                   "inspection plan JSON: regions, comparison points, defect detection "
                   "(docs/inspection-plan.md); its default band is +-tolerance");

@@ -7,6 +7,7 @@
 
 #include "client/cell/cell_config.h"
 #include "client/cell/part_outputs.h"
+#include "client/cell/report_context.h"
 #include "client/cli/commands.h"
 #include "client/cli/remote_args.h"
 #include "core/io/io_mesh.h"
@@ -25,7 +26,8 @@ struct InspectArgs {
 
 void Inspect(const InspectArgs& a) {
   const client::CellConfig cell = Take(client::ReadCellConfig(a.cell));
-  const TriangleMesh part = Take(ReadMesh(cell.part_mesh));
+  const auto part_ptr = std::make_shared<const TriangleMesh>(Take(ReadMesh(cell.part_mesh)));
+  const TriangleMesh& part = *part_ptr;
   InspectionSettings settings = client::InspectionSettingsOf(cell);
   if (a.tolerance != 0) settings.error_map.tolerance_mm = a.tolerance;
   Check(ValidateErrorMapSettings(settings.error_map));
@@ -64,6 +66,8 @@ void Inspect(const InspectArgs& a) {
   }
   outputs.cell = cell.name;
   outputs.world_from_part = cell.world_from_part;
+  outputs.mesh_in_part = part_ptr;
+  outputs.viewpoints = client::ViewpointCalibrations(cell);
   Check(client::WritePartOutputs(a.out, outputs));
   std::printf("%s: %s  (min %.3f mm, max %.3f mm)  -> %s\n", part_id.c_str(),
               outputs.verdict.c_str(), outputs.min_mm, outputs.max_mm, a.out.c_str());
@@ -80,7 +84,7 @@ void AddInspectCommand(CLI::App& app) {
       ->required();
   cmd->add_option("--scans", a->scans, "folder with <viewpoint>.pcd scans of one part")->required();
   cmd->add_option("--out", a->out,
-                  "results folder (report.json, errormap.ply/.png, deviations.csv)")
+                  "results folder (report.json, report.html, errormap.ply/.png, deviations.csv)")
       ->required();
   cmd->add_option("--part-id", a->part_id, "default: the scans folder's name");
   cmd->add_option("--tolerance", a->tolerance, "override the cell's tolerance, mm (0 = keep)");

@@ -109,3 +109,17 @@ foreach(bad "bad1.json|plan.regions\\[0\\].select.box_mm" "bad2.json|plan.points
     message(FATAL_ERROR "${file} must be refused naming ${want}: ${rc}\n${err}")
   endif()
 endforeach()
+# --html: the self-contained report; a region name with markup and quotes is
+# escaped, never markup.
+file(WRITE ${WORK}/evil_plan.json "{\"regions\": [{\"name\": \"<script>x</script>'q'\", \"select\": {\"box_mm\": [[-1, -1, -1], [11, 11, 1]]}}]}")
+execute_process(COMMAND ${CLI} ${ARGS} --plan ${WORK}/evil_plan.json --html ${WORK}/o.html
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 AND NOT rc EQUAL 1)
+  message(FATAL_ERROR "errormap --html failed: ${rc}\n${out}\n${err}")
+endif()
+file(READ ${WORK}/o.html html)
+string(FIND "${html}" "<script>x" raw)
+string(FIND "${html}" "&lt;script&gt;x&lt;/script&gt;&#39;q&#39;" escaped)
+if(NOT html MATCHES "^<!doctype html>" OR NOT raw EQUAL -1 OR escaped EQUAL -1)
+  message(FATAL_ERROR "report.html is not the escaped page (raw at ${raw}, escaped at ${escaped})")
+endif()

@@ -100,10 +100,28 @@ TEST_F(AgentTest, UnavailableTwiceThenOkIsDoneAfterThreeCalls) {
   EXPECT_EQ(r.verdict, "pass");
   EXPECT_DOUBLE_EQ(r.max_mm, 0.25);
   EXPECT_DOUBLE_EQ(r.min_mm, -0.125);
-  for (const char* f : {"report.json", "errormap.ply", "errormap.png", "deviations.csv"})
+  for (const char* f :
+       {"report.json", "report.html", "errormap.ply", "errormap.png", "deviations.csv"})
     EXPECT_TRUE(fs::exists(fs::path(layout_.results) / "p1" / f)) << f;
   EXPECT_FALSE(InInbox("p1"));
   EXPECT_TRUE(fs::exists(fs::path(layout_.archive) / "p1" / "v1.pcd"));
+}
+
+TEST_F(AgentTest, ReportHtmlCarriesTheCellAndTheMeshReadOnce) {
+  cell_.name = "cell-7";
+  cell_.part_mesh = tmp_.path() + "/part.off";
+  WriteBytes(cell_.part_mesh, "OFF\n3 1 0\n0 0 0\n10 0 0\n0 10 0\n3 0 1 2\n");
+  DropPart("p1");
+  DropPart("p2");
+  CellAgent agent = Agent();
+  EXPECT_EQ(agent.ProcessPart("p1", stop_).outcome, PartOutcome::kDone);
+  fs::remove(cell_.part_mesh);  // read once: the second part still has it
+  EXPECT_EQ(agent.ProcessPart("p2", stop_).outcome, PartOutcome::kDone);
+  for (const char* id : {"p1", "p2"}) {
+    const std::string html = ReadBytes((fs::path(layout_.results) / id / "report.html").string());
+    EXPECT_NE(html.find("\"triangles\":1"), std::string::npos) << id;
+    EXPECT_NE(html.find("cell cell-7"), std::string::npos) << id;
+  }
 }
 
 TEST_F(AgentTest, InvalidArgumentGoesToQuarantineWithErrorTxt) {

@@ -1,0 +1,45 @@
+// The HTML report's panels beside the 3D viewer, built from report.json
+// ("schema": "surfinspect.report/2", docs/inspection-plan.md) and the part's
+// context. Every string taken from the report or the context is escaped
+// (core/report/html_escape.h). Numbers the page's tests read back carry
+// their exact JSON text in a data-value attribute.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace surfinspect {
+
+// A viewpoint's calibration as cell.json holds it.
+struct ViewpointCalibration {
+  std::string name;
+  bool calibrated = false;  // has a calibrated world_from_sensor
+  nlohmann::json quality;   // core's calibration quality JSON (rms_mm, converged, warnings, ...),
+                            // null when not stored
+};
+
+struct HtmlReportContext {
+  std::string part_id;
+  std::string cell;                              // empty: not known
+  std::vector<ViewpointCalibration> viewpoints;  // empty: not known
+};
+
+// The part verdict banner: part id, cell, verdict, the tolerance reason.
+std::string VerdictBanner(const nlohmann::json& report, const HtmlReportContext& context);
+
+// Characteristics, failed rows first (otherwise in the report's order).
+std::string CharacteristicsTable(const nlohmann::json& report);
+
+// Defects, one row per defect with data-defect="ID" (the viewer flies there).
+std::string DefectsTable(const nlohmann::json& report);
+
+// Statistics over all points (report "points" and "statistics").
+std::string StatisticsTable(const nlohmann::json& report);
+
+// Every key of report "settings" (and "inputs", the file names, when present).
+std::string SettingsTable(const nlohmann::json& report);
+
+std::string CalibrationTable(const HtmlReportContext& context);
+
+}  // namespace surfinspect

@@ -1,0 +1,297 @@
+// The HTML report's 3D viewer (core/report/html_report.h). Reads the page's
+// data (<script id="si-data">, JSON) and payload (<script id="si-payload">,
+// base64 of little-endian typed arrays, core/report/html_payload.h) and shows
+// the measured points in the part frame, coloured by the error map's palette
+// index computed in C++, the CAD mesh as a translucent overlay, the defects
+// with their ids, and a colour legend in mm. window.surfinspect reports
+// `ready` and the time it took (ms since navigation start) for tests.
+import * as THREE from 'three';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+
+const state = { ready: false, errors: [], shown: 0, tti_ms: null, views: 0, picks: 0, timings: {} };
+const mark = (name) => { state.timings[name] = Math.round(performance.now()); };
+mark('module');
+window.surfinspect = state;
+window.addEventListener('error', (e) => state.errors.push(String(e.message)));
+
+const data = JSON.parse(document.getElementById('si-data').textContent);
+const RUN = 84; // core/report/deviation_palette.h
+
+function decodeBase64(text) {
+  if (Uint8Array.fromBase64) return Uint8Array.fromBase64(text);
+  const bin = atob(text);
+  const out = new Uint8Array(bin.length);
+  for (let i = 0; i < bin.length; ++i) out[i] = bin.charCodeAt(i);
+  return out;
+}
+
+function typed(bytes, [offset, length], Type) {
+  return new Type(bytes.buffer, bytes.byteOffset + offset, length / Type.BYTES_PER_ELEMENT);
+}
+
+// The palette index of a deviation, as core/report/deviation_palette.cpp
+// computes it; used to draw the legend (points carry their index).
+function paletteIndex(d) {
+  if (Number.isNaN(d)) return 0;
+  const tol = data.tolerance_mm, range = data.range_mm;
+  const bin = (f) => Math.min(RUN - 1, Math.max(0, Math.floor(f * RUN)));
+  if (Math.abs(d) <= tol) return 86 + bin((d / tol + 1) / 2);
+  const s = range > tol ? (Math.abs(d) - tol) / (range - tol) : 1;
+  if (s > 1) return d > 0 ? 254 : 1;
+  return d > 0 ? 170 + bin(s) : 2 + RUN - 1 - bin(s);
+}
+
+function rgb(index) {
+  const p = data.palette;
+  return `rgb(${p[3 * index]},${p[3 * index + 1]},${p[3 * index + 2]})`;
+}
+
+function dequantise(q, min, step, centre) {
+  const out = new Float32Array(q.length);
+  for (let i = 0; i < q.length; i += 3)
+    for (let a = 0; a < 3; ++a) out[i + a] = min[a] + q[i + a] * step[a] - centre[a];
+  return out;
+}
+
+function buildPoints(bytes, centre) {
+  const P = data.points;
+  const q = typed(bytes, P.positions, Uint16Array);
+  const index = typed(bytes, P.palette_index, Uint8Array);
+  const colors = new Uint8Array(3 * P.shown);
+  for (let i = 0; i < P.shown; ++i)
+    for (let a = 0; a < 3; ++a) colors[3 * i + a] = data.palette[3 * index[i] + a];
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.BufferAttribute(dequantise(q, P.min, P.step, centre), 3));
+  geometry.setAttribute('color', new THREE.BufferAttribute(colors, 3, true));
+  geometry.computeBoundingSphere();
+  const ext = P.step.map((s) => s * 65535).sort((a, b) => b - a);
+  const spacing = Math.sqrt(Math.max(ext[0] * ext[1], 1e-6) / Math.max(P.shown, 1));
+  const material = new THREE.PointsMaterial({ size: 2 * spacing, vertexColors: true });
+  const points = new THREE.Points(geometry, material);
+  points.userData.deviations = typed(bytes, P.deviations, Int16Array);
+  points.userData.spacing = spacing;
+  return points;
+}
+
+function buildMesh(bytes, centre) {
+  const M = data.mesh;
+  if (!M) return null;
+  const geometry = new THREE.BufferGeometry();
+  const q = typed(bytes, M.positions, Uint16Array);
+  geometry.setAttribute('position', new THREE.BufferAttribute(dequantise(q, M.min, M.step, centre), 3));
+  geometry.setIndex(new THREE.BufferAttribute(typed(bytes, M.indices, Uint32Array), 1));
+  // Unlit: one cheap shader program less to compile before the first frame.
+  const material = new THREE.MeshBasicMaterial({
+    color: 0xb8c4d0, transparent: true, opacity: 0.16, depthWrite: false, side: THREE.DoubleSide,
+  });
+  return new THREE.Mesh(geometry, material);
+}
+
+function drawLegend(canvas) {
+  const g = canvas.getContext('2d');
+  const { width: w, height: h } = canvas;
+  const range = data.range_mm, tol = data.tolerance_mm, span = 1.12 * range;
+  const top = 14, bottom = h - 40, barX = 8, barW = 22;
+  const yOf = (d) => top + ((span - d) / (2 * span)) * (bottom - top);
+  g.fillStyle = 'rgba(255,255,255,0.9)';
+  g.fillRect(0, 0, w, h);
+  for (let y = top; y < bottom; ++y) {
+    const d = span - ((y - top + 0.5) / (bottom - top)) * 2 * span;
+    g.fillStyle = rgb(paletteIndex(d));
+    g.fillRect(barX, y, barW, 1);
+  }
+  g.fillStyle = '#111';
+  g.font = '11px sans-serif';
+  g.textBaseline = 'middle';
+  for (const d of [range, tol, 0, -tol, -range]) {
+    const y = yOf(d);
+    g.fillRect(barX + barW, Math.round(y), 5, 1);
+    g.fillText(`${d > 0 ? '+' : ''}${+d.toPrecision(4)} mm`, barX + barW + 8, y);
+  }
+  g.fillStyle = rgb(0);
+  g.fillRect(barX, h - 30, barW, 12);
+  g.fillStyle = '#111';
+  g.fillText('unmatched', barX + barW + 8, h - 24);
+  g.fillText('deviation', barX, 6);
+}
+
+const VIEWS = {
+  iso: [1, -1, 0.8], top: [0, -1e-4, 1], bottom: [0, 1e-4, -1], front: [0, -1, 0],
+  back: [0, 1, 0], left: [-1, 0, 0], right: [1, 0, 0],
+};
+
+function main() {
+  const viewer = document.getElementById('viewer');
+  const note = document.getElementById('viewer-note');
+  const P = data.points;
+  note.textContent = `${P.shown.toLocaleString('en')} of ${P.finite.toLocaleString('en')} points shown` +
+    (P.thinned ? ` (thinned on a grid: up to ${P.per_cell} per ${P.cell_mm.toPrecision(3)} mm cell, ` +
+      'largest |deviation| first; the statistics are over all points)' : '') +
+    (data.mesh_omitted ? '; the CAD mesh is too large to embed' : '');
+  drawLegend(document.getElementById('legend'));
+  if (P.shown === 0) { state.ready = true; state.tti_ms = performance.now(); return; }
+  THREE.ColorManagement.enabled = false; // the palette's bytes reach the screen unchanged
+  const renderer = new THREE.WebGLRenderer({ antialias: false });
+  renderer.outputColorSpace = THREE.LinearSRGBColorSpace;
+  renderer.setPixelRatio(window.devicePixelRatio || 1);
+  renderer.domElement.classList.add('gl');
+  viewer.prepend(renderer.domElement);
+  const bytes = decodeBase64(document.getElementById('si-payload').textContent);
+  mark('decoded');
+  const centre = [0, 1, 2].map((a) => P.min[a] + P.step[a] * 32767.5);
+  const scene = new THREE.Scene();
+  scene.background = new THREE.Color(0x20242a);
+  const points = buildPoints(bytes, centre);
+  scene.add(points);
+  const mesh = buildMesh(bytes, centre);
+  if (mesh) scene.add(mesh);
+  mark('built');
+  const radius = points.geometry.boundingSphere.radius || 1;
+  const camera = new THREE.PerspectiveCamera(35, 1, radius / 1000, radius * 20);
+  camera.up.set(0, 0, 1);
+  const controls = new OrbitControls(camera, renderer.domElement);
+  const defects = addDefects(scene, centre, radius);
+  const view = { renderer, scene, camera, controls, points, defects, radius, centre, anim: null };
+  wire(view, mesh);
+  setView(view, 'iso', false);
+  const resize = () => {
+    renderer.setSize(viewer.clientWidth, viewer.clientHeight, false);
+    camera.aspect = viewer.clientWidth / Math.max(viewer.clientHeight, 1);
+    camera.updateProjectionMatrix();
+    render(view);
+  };
+  new ResizeObserver(resize).observe(viewer);
+  resize();
+  mark('rendered');
+  // For benchmarks: one frame drawn to completion, ms.
+  state.frame_ms = () => {
+    const t = performance.now();
+    render(view);
+    renderer.getContext().finish();
+    return performance.now() - t;
+  };
+  state.shown = P.shown;
+  state.ready = true;
+  state.tti_ms = performance.now();
+}
+
+function addDefects(scene, centre, radius) {
+  const labels = document.getElementById('labels');
+  return data.defects.filter((d) => Array.isArray(d.centroid_mm)).map((d) => {
+    const at = new THREE.Vector3(...d.centroid_mm.map((v, a) => v - centre[a]));
+    const r = Math.max((d.extent_mm || 0) / 2, radius / 200);
+    const ring = new THREE.Mesh(new THREE.SphereGeometry(r, 16, 10),
+      new THREE.MeshBasicMaterial({ color: 0xff33ff, wireframe: true, transparent: true, opacity: 0.7 }));
+    ring.position.copy(at);
+    scene.add(ring);
+    const label = document.createElement('div');
+    label.className = 'label';
+    label.textContent = `D${d.id} ${d.kind ?? ''} ${d.peak_mm != null ? (+d.peak_mm).toFixed(3) + ' mm' : ''}`;
+    labels.appendChild(label);
+    return { defect: d, at, ring, label, r };
+  });
+}
+
+function render(view) {
+  const { renderer, scene, camera, defects } = view;
+  renderer.render(scene, camera);
+  const w = renderer.domElement.clientWidth, h = renderer.domElement.clientHeight;
+  const v = new THREE.Vector3();
+  for (const m of defects) {
+    v.copy(m.at).project(camera);
+    const visible = m.ring.visible && v.z < 1 && Math.abs(v.x) <= 1 && Math.abs(v.y) <= 1;
+    m.label.style.display = visible ? '' : 'none';
+    m.label.style.left = `${((v.x + 1) / 2) * w}px`;
+    m.label.style.top = `${((1 - v.y) / 2) * h}px`;
+  }
+}
+
+// Moves the camera to look at `target` from `target + dir * distance`,
+// animated over 500 ms unless `animate` is false.
+function moveCamera(view, target, position, animate) {
+  const { camera, controls } = view;
+  const from = { t: controls.target.clone(), p: camera.position.clone() };
+  const start = performance.now(), ms = animate ? 500 : 0;
+  const step = () => {
+    const k = ms ? Math.min(1, (performance.now() - start) / ms) : 1;
+    const e = k * k * (3 - 2 * k);
+    controls.target.lerpVectors(from.t, target, e);
+    camera.position.lerpVectors(from.p, position, e);
+    controls.update();
+    render(view);
+    if (k < 1) view.anim = requestAnimationFrame(step);
+    else view.anim = null;
+  };
+  if (view.anim) cancelAnimationFrame(view.anim);
+  step();
+}
+
+function setView(view, name, animate = true) {
+  const dir = new THREE.Vector3(...VIEWS[name]).normalize();
+  const distance = view.radius / Math.sin(THREE.MathUtils.degToRad(35 / 2)) * 1.05;
+  moveCamera(view, new THREE.Vector3(), dir.multiplyScalar(distance), animate);
+  state.views += 1;
+}
+
+function flyToDefect(view, id) {
+  const m = view.defects.find((x) => String(x.defect.id) === String(id));
+  if (!m) return;
+  const dir = view.camera.position.clone().sub(view.controls.target).normalize();
+  const distance = Math.max(8 * m.r, view.radius / 10);
+  moveCamera(view, m.at.clone(), m.at.clone().add(dir.multiplyScalar(distance)), true);
+  document.querySelectorAll('tr.defect').forEach((tr) =>
+    tr.classList.toggle('selected', tr.dataset.defect === String(id)));
+}
+
+// The deviation under the pointer (nearest shown point along the ray).
+function pick(view, event) {
+  const rect = view.renderer.domElement.getBoundingClientRect();
+  const ndc = new THREE.Vector2(((event.clientX - rect.left) / rect.width) * 2 - 1,
+    -((event.clientY - rect.top) / rect.height) * 2 + 1);
+  const ray = new THREE.Raycaster();
+  ray.params.Points.threshold = 2 * view.points.userData.spacing;
+  ray.setFromCamera(ndc, view.camera);
+  const hit = ray.intersectObject(view.points)[0];
+  const box = document.getElementById('hover');
+  if (!hit) { box.hidden = true; return; }
+  const q = view.points.userData.deviations[hit.index];
+  const p = hit.point.toArray().map((v, a) => (v + view.centre[a]).toFixed(2));
+  box.hidden = false;
+  box.textContent = q === -32768 ? `unmatched at (${p.join(', ')}) mm`
+    : `deviation ${(q * data.points.deviation_step_mm).toFixed(4)} mm at (${p.join(', ')}) mm`;
+  state.picks += 1;
+}
+
+function wire(view, mesh) {
+  view.controls.addEventListener('change', () => { if (!view.anim) render(view); });
+  document.querySelectorAll('#toolbar button[data-view]').forEach((b) =>
+    b.addEventListener('click', () => setView(view, b.dataset.view)));
+  const meshToggle = document.getElementById('mesh-toggle');
+  meshToggle.disabled = !mesh;
+  meshToggle.addEventListener('change', () => { if (mesh) mesh.visible = meshToggle.checked; render(view); });
+  const defectToggle = document.getElementById('defect-toggle');
+  defectToggle.addEventListener('change', () => {
+    for (const m of view.defects) m.ring.visible = defectToggle.checked;
+    render(view);
+  });
+  document.querySelectorAll('tr.defect').forEach((tr) => {
+    tr.addEventListener('click', () => flyToDefect(view, tr.dataset.defect));
+    tr.addEventListener('keydown', (e) => { if (e.key === 'Enter') flyToDefect(view, tr.dataset.defect); });
+  });
+  let pending = null, last = null;
+  const canvas = view.renderer.domElement;
+  canvas.addEventListener('pointermove', (e) => {
+    if (e.buttons) return;
+    last = e;
+    if (!pending) pending = requestAnimationFrame(() => { pending = null; pick(view, last); });
+  });
+  canvas.addEventListener('click', (e) => pick(view, e));
+}
+
+try {
+  main();
+} catch (e) {
+  state.errors.push(String(e));
+  document.getElementById('viewer-note').textContent = `3D view unavailable: ${e.message}`;
+  throw e;
+}

@@ -1,0 +1,214 @@
+// Tests of the HTML report: core/report/html_report.cpp (the page),
+// core/report/html_escape.cpp, core/report/html_sections.cpp and
+// core/report/html_histogram.cpp (its parts).
+#include "core/report/html_report.h"
+
+#include <gtest/gtest.h>
+
+#include <regex>
+
+#include "core/report/html_escape.h"
+#include "core/report/html_histogram.h"
+#include "tests/support/temp_dir.h"
+
+namespace surfinspect {
+namespace {
+
+using nlohmann::json;
+
+const std::string kEvil = "<script>alert(\"x\")</script> it's & \"quoted\"";
+
+std::size_t Count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+json Report() {
+  return json::parse(R"({
+    "schema": "surfinspect.report/2", "verdict": "fail", "color_range_mm": 1.0,
+    "tolerance": {"band_mm": 0.3, "reason": "fail: too much outside", "within": 9, "above": 1,
+                  "below": 0, "fraction_within": 0.9},
+    "points": {"count": 12, "valid": 11, "matched": 10},
+    "statistics": {"min_mm": -0.25, "max_mm": 0.75, "mean_mm": 0.1234567890123,
+                   "stddev_mm": 0.2, "rms_mm": 0.21, "p1_mm": -0.2, "p5_mm": -0.1,
+                   "p50_mm": 0.05, "p95_mm": 0.5, "p99_mm": 0.7},
+    "histogram": {"min_mm": -1, "max_mm": 1, "counts": [0, 1, 1000000, 2, 0],
+                  "below_range": 0, "above_range": 3},
+    "settings": {"tolerance_mm": 0.3, "histogram_bins": 5},
+    "characteristics": [
+      {"name": "surface", "type": "surface", "verdict": "pass", "points": 10,
+       "tolerance_mm": {"lower": -0.3, "upper": 0.3}},
+      {"name": "REGION", "type": "region", "verdict": "fail", "points": 4,
+       "tolerance_mm": {"lower": -0.1, "upper": 0.1}, "reason": "REGION"}],
+    "defects": [{"id": 1, "kind": "dent", "centroid_mm": [1, 2, 3], "extent_mm": 4,
+                 "peak_mm": -0.4, "points": 7, "area_mm2": 5, "region": "REGION"}]
+  })");
+}
+
+json EvilReport() {
+  json r = Report();
+  r["characteristics"][1]["name"] = kEvil;
+  r["characteristics"][1]["reason"] = kEvil;
+  r["defects"][0]["region"] = kEvil;
+  r["inputs"] = {{"cloud", kEvil + ".ply"}};
+  return r;
+}
+
+struct Points {
+  PointCloud cloud;
+  std::vector<float> deviation;
+};
+
+Points SomePoints(std::size_t n) {
+  Points p;
+  for (std::size_t i = 0; i < n; ++i) {
+    p.cloud.points.emplace_back(static_cast<float>(i % 100), static_cast<float>(i / 100), 0.0f);
+    p.deviation.push_back(static_cast<float>(i % 17) / 10 - 0.8f);
+  }
+  p.cloud.width = static_cast<uint32_t>(n);
+  p.cloud.height = 1;
+  return p;
+}
+
+std::string ScriptText(const std::string& html, const std::string& id) {
+  const std::string open = "id=\"" + id + "\">";
+  const auto begin = html.find(open);
+  EXPECT_NE(begin, std::string::npos) << id;
+  const auto end = html.find("</script>", begin);
+  return html.substr(begin + open.size(), end - begin - open.size());
+}
+
+absl::StatusOr<HtmlReportPage> Page(const json& report, const Points& p,
+                                    const std::string& part_id = "part-1",
+                                    std::size_t max_points = 1'000'000) {
+  HtmlReportInput in;
+  in.report = &report;
+  in.points_in_part = &p.cloud;
+  in.deviation_mm = &p.deviation;
+  in.context.part_id = part_id;
+  in.context.cell = "cell-A";
+  in.context.viewpoints = {{"v1", true, {{"rms_mm", 0.014}, {"converged", true}}},
+                           {"v2", false, nullptr}};
+  in.payload.max_points = max_points;
+  return BuildHtmlReport(in);
+}
+
+TEST(HtmlEscape, EscapesMarkupAndQuotes) {
+  EXPECT_EQ(HtmlEscape("<a href=\"x\">'&'</a>"),
+            "&lt;a href=&quot;x&quot;&gt;&#39;&amp;&#39;&lt;/a&gt;");
+  EXPECT_EQ(HtmlEscape("plain part-001"), "plain part-001");
+}
+
+TEST(HtmlEscape, JsonForScriptCannotCloseTheElementAndParsesBack) {
+  const json value = {{"name", kEvil}, {"sep", "a\u2028b\u2029c"}, {"comment", "<!-- -->"}};
+  const std::string text = JsonForScript(value);
+  EXPECT_EQ(text.find('<'), std::string::npos);
+  EXPECT_EQ(text.find('>'), std::string::npos);
+  EXPECT_EQ(text.find('&'), std::string::npos);
+  EXPECT_EQ(text.find("\xE2\x80\xA8"), std::string::npos);
+  EXPECT_EQ(json::parse(text), value);
+}
+
+TEST(HtmlReport, NothingFromOutsideBecomesMarkup) {
+  const Points p = SomePoints(500);
+  auto page = Page(EvilReport(), p, "<b>\"part\"</b>");
+  ASSERT_TRUE(page.ok()) << page.status();
+  const std::string& html = page->html;
+  // Only the page's own four script elements: import map, data, payload, viewer.
+  EXPECT_EQ(Count(html, "<script"), 4u);
+  EXPECT_EQ(Count(html, "</script"), 4u);
+  EXPECT_EQ(Count(html, "<b>"), 0u);
+  EXPECT_GE(Count(html, "&lt;script&gt;alert(&quot;x&quot;)&lt;/script&gt; it&#39;s &amp;"), 4u);
+  EXPECT_NE(html.find("&lt;b&gt;&quot;part&quot;&lt;/b&gt;"), std::string::npos);
+  const json data = json::parse(ScriptText(html, "si-data"));
+  EXPECT_EQ(data["defects"][0]["region"], kEvil);
+  EXPECT_EQ(data["part_id"], "<b>\"part\"</b>");
+}
+
+TEST(HtmlReport, StatisticsAreTheReportsWhateverTheThinning) {
+  const Points p = SomePoints(20000);
+  auto full = Page(Report(), p);
+  auto thin = Page(Report(), p, "part-1", 1000);
+  ASSERT_TRUE(full.ok() && thin.ok());
+  EXPECT_EQ(full->shown_points, 20000u);
+  EXPECT_LE(thin->shown_points, 1000u);
+  const std::regex cell(R"re(data-key="([a-z0-9_]+)" data-value="([^"]*)")re");
+  auto values = [&](const std::string& html) {
+    std::map<std::string, std::string> out;
+    for (auto it = std::sregex_iterator(html.begin(), html.end(), cell);
+         it != std::sregex_iterator(); ++it)
+      out[(*it)[1]] = (*it)[2];
+    return out;
+  };
+  const auto a = values(full->html), b = values(thin->html);
+  EXPECT_EQ(a, b);
+  const json report = Report();
+  ASSERT_EQ(a.count("mean_mm"), 1u);
+  EXPECT_EQ(json::parse(a.at("mean_mm")).get<double>(),
+            report["statistics"]["mean_mm"].get<double>());
+  EXPECT_EQ(a.at("matched"), "10");
+  EXPECT_EQ(a.at("p99_mm"), "0.7");
+}
+
+TEST(HtmlReport, PanelsFailedFirstDefectsCalibrationHistogram) {
+  const Points p = SomePoints(100);
+  auto page = Page(Report(), p);
+  ASSERT_TRUE(page.ok());
+  const std::string& html = page->html;
+  EXPECT_LT(html.find("<td>REGION</td>"), html.find("<td>surface</td>"));  // failed first
+  EXPECT_NE(html.find("data-defect=\"1\""), std::string::npos);
+  EXPECT_NE(html.find("class=\"banner fail\""), std::string::npos);
+  EXPECT_NE(html.find("<td>v2</td><td class=\"fail\">not calibrated</td>"), std::string::npos);
+  EXPECT_NE(html.find("<svg id=\"histogram\""), std::string::npos);
+  EXPECT_NE(html.find("type=\"importmap\""), std::string::npos);
+  EXPECT_EQ(html.find("https://"), std::string::npos);  // no network
+}
+
+TEST(HtmlHistogram, LogAxisKeepsSmallBinsVisible) {
+  const std::string svg = HistogramSvg(Report(), MakeDeviationPalette(0.3, 1.0));
+  // The bin with 1 count is log10(2) / log10(1e6 + 1) ~ 5% of the tallest, not 1e-6.
+  const std::regex bar(R"re(<rect x="[0-9.]+" y="[0-9.]+" width="[0-9.]+" height="([0-9.]+)")re");
+  std::vector<double> heights;
+  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), bar); it != std::sregex_iterator();
+       ++it)
+    heights.push_back(std::stod((*it)[1]));
+  ASSERT_EQ(heights.size(), 5u);
+  EXPECT_NEAR(heights[1] / heights[2], std::log10(2.0) / std::log10(1e6 + 1), 1e-3);
+  EXPECT_EQ(heights[0], 0);
+  EXPECT_NE(svg.find("class=\"band\""), std::string::npos);
+}
+
+TEST(HtmlReport, RefusesIncompleteInput) {
+  const Points p = SomePoints(10);
+  json no_band = Report();
+  no_band["tolerance"].erase("band_mm");
+  EXPECT_EQ(Page(no_band, p).status().code(), absl::StatusCode::kInvalidArgument);
+  HtmlReportInput in;
+  EXPECT_EQ(BuildHtmlReport(in).status().code(), absl::StatusCode::kInvalidArgument);
+  // Fields of unexpected types are shown as they are or left out, never a crash.
+  json odd = Report();
+  odd["verdict"] = 3;
+  odd["histogram"] = "none";
+  odd["defects"] = {1, "two", nullptr};
+  odd["characteristics"] = 5;
+  odd["statistics"] = nullptr;
+  auto page = Page(odd, p);
+  ASSERT_TRUE(page.ok()) << page.status();
+  EXPECT_NE(page->html.find("no histogram"), std::string::npos);
+}
+
+TEST(HtmlReport, WritesTheFile) {
+  testing::TempDir dir;
+  const Points p = SomePoints(10);
+  const json report = Report();
+  HtmlReportInput in;
+  in.report = &report;
+  in.points_in_part = &p.cloud;
+  in.deviation_mm = &p.deviation;
+  ASSERT_TRUE(WriteHtmlReport(dir.File("report.html"), in).ok());
+  EXPECT_EQ(testing::ReadBytes(dir.File("report.html")).rfind("<!doctype html>", 0), 0u);
+}
+
+}  // namespace
+}  // namespace surfinspect
