@@ -169,26 +169,25 @@ json AcceptanceReportJson(const AcceptanceResult& r, const Artefacts& a) {
                       {"rms_mm", f.fit.rms},
                       {"points", f.kept},
                       {"left_out", f.left_out}});
-  return {{"schema", "surfinspect.acceptance/1"},
-          {"guideline", "VDI/VDE 2634 Part 2 (PF, PS, SD, F) and Part 3 (SD across viewpoints)"},
-          {"PF_mm", FigureJson(r.pf)},
-          {"PS_mm", FigureJson(r.ps)},
-          {"F_mm", FigureJson(r.f)},
-          {"SD_mm", sd},
-          {"verdict", r.pass ? "pass" : "fail"},
-          {"uncertainty", "u: standard (k = 1); U = 2u (k = 2); pass: |value| <= mpe"},
-          {"spheres", spheres},
-          {"plates", plates},
-          {"cross_view", CrossViewJson(r)},
-          {"deviations",
-           {absl::StrCat("PF and F leave out the ", 100 * a.outlier_share,
-                         " % of points with the largest |residual| (the guideline allows 0.3 %)"),
-            absl::StrCat("points are selected within ", a.band_mm,
-                         " mm of a first least-squares fit, after the cell's link-clustering "
-                         "filter"),
-            "one placement per sphere and plate measurement listed, not the guideline's full "
-            "set of positions",
-            "the ball bar is two spheres; its rod and mounts are not modelled"}}};
+  return {
+      {"schema", "surfinspect.acceptance/1"},
+      {"guideline", "VDI/VDE 2634 Part 2 (PF, PS, SD, F) and Part 3 (SD across viewpoints)"},
+      {"PF_mm", FigureJson(r.pf)},
+      {"PS_mm", FigureJson(r.ps)},
+      {"F_mm", FigureJson(r.f)},
+      {"SD_mm", sd},
+      {"verdict", r.pass ? "pass" : "fail"},
+      {"uncertainty", "u: standard (k = 1); U = 2u (k = 2); pass: |value| <= mpe"},
+      {"spheres", spheres},
+      {"plates", plates},
+      {"cross_view", CrossViewJson(r)},
+      {"deviations",
+       {absl::StrCat("PF and F leave out the ", 100 * a.outlier_share,
+                     " % of points with the largest |residual| (the guideline allows 0.3 %)"),
+        absl::StrCat("points are selected within ", a.band_mm, " mm of a first least-squares fit"),
+        "one placement per sphere and plate measurement listed, not the guideline's full "
+        "set of positions",
+        "the ball bar is two spheres; its rod and mounts are not modelled"}}};
 }
 
 }  // namespace surfinspect
