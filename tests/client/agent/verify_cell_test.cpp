@@ -121,7 +121,9 @@ TEST_F(VerifyCellTest, FailStopsTheAgentAndLeavesPartsInTheInbox) {
   config.every_parts = 1;
   DriftMonitor monitor(config, [&] {
     auto v = VerifyCell(cell, *index_, Robot(cell, 0.020, 5), config.limits);
-    if (v.ok()) EXPECT_TRUE(WriteVerificationStatus(tmp.path(), cell, *v).ok());
+    if (v.ok()) {
+      EXPECT_TRUE(WriteVerificationStatus(tmp.path(), cell, *v).ok());
+    }
     return v;
   });
   AgentHooks hooks;
