@@ -164,6 +164,43 @@ TEST_F(VerifyCellTest, FailStopsTheAgentAndLeavesPartsInTheInbox) {
       << *prom;
 }
 
+TEST(DriftMonitor, ChecksEveryNPartsAndOnScheduleAndStaysStoppedAfterAFail) {
+  auto now = std::chrono::steady_clock::time_point{};
+  int checks = 0;
+  DriftClass next = DriftClass::kOk;
+  VerifyConfig config;
+  config.every_parts = 3;
+  config.every_s = 60;
+  DriftMonitor m(
+      config,
+      [&]() -> absl::StatusOr<CellVerification> {
+        ++checks;
+        CellVerification v;
+        v.verdict = next;
+        v.reason = "v1: moved";
+        return v;
+      },
+      [&] { return now; });
+  EXPECT_TRUE(m.BeforePart(0).ok());
+  EXPECT_TRUE(m.BeforePart(2).ok());
+  EXPECT_EQ(checks, 0);
+  EXPECT_TRUE(m.BeforePart(3).ok());  // 3 parts since the start
+  EXPECT_EQ(checks, 1);
+  EXPECT_TRUE(m.BeforePart(4).ok());
+  now += std::chrono::seconds(61);  // the schedule, before 3 more parts
+  next = DriftClass::kWarn;         // a warning does not stop
+  EXPECT_TRUE(m.BeforePart(4).ok());
+  EXPECT_EQ(checks, 2);
+  next = DriftClass::kFail;
+  const absl::Status st = m.BeforePart(7);
+  EXPECT_EQ(checks, 3);
+  EXPECT_EQ(st.code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_EQ(st.message(), "calibration drift: v1: moved");
+  next = DriftClass::kOk;
+  EXPECT_FALSE(m.BeforePart(8).ok());  // stays stopped until recalibrated and restarted
+  EXPECT_EQ(checks, 3);
+}
+
 TEST_F(VerifyCellTest, VerifyWithoutStoredCalibrationIsAClearError) {
   CellConfig cell = OneView();
   cell.viewpoints[0].world_from_sensor.reset();
