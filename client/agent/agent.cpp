@@ -220,6 +220,11 @@ RunSummary CellAgent::Run(const std::atomic<bool>& stop,
     bool progressed = false;
     for (const auto& id : CompleteParts(layout_.inbox)) {
       if (stop.load()) break;
+      if (hooks_.before_part)
+        if (absl::Status st = hooks_.before_part(s.done); !st.ok()) {
+          s.halted = std::string(st.message());
+          return s;
+        }
       const PartReport r = ProcessPart(id, stop);
       if (on_part) on_part(r);
       switch (r.outcome) {

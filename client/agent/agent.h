@@ -73,6 +73,7 @@ struct PartReport {
 struct RunSummary {
   int done = 0, pass = 0, archived_without_call = 0, quarantined = 0;
   bool config_error = false;  // Run stopped on a kConfigError part
+  std::string halted;         // Run stopped because before_part refused: its reason
 };
 
 // Streams one part (header + views) and returns the server's result.
@@ -92,6 +93,11 @@ struct AgentHooks {
   std::vector<std::function<void(const std::string& part_id)>> on_started;
   std::vector<std::function<void(const std::string& part_id, const std::string& results_dir)>>
       on_stored;
+  // Asked before each part is picked up, with the number inspected so far in
+  // this Run (e.g. the calibration drift check, client/agent/verify_cell.h).
+  // A non-OK answer stops Run: that part and the rest stay in the inbox, and
+  // RunSummary::halted carries the message.
+  std::function<absl::Status(int parts_done)> before_part;
 };
 
 class CellAgent {

@@ -12,15 +12,18 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdio>
+#include <filesystem>
 
 #include "absl/strings/ascii.h"
 #include "client/agent/agent.h"
 #include "client/agent/calibrate_cell.h"
 #include "client/agent/simulated_robot.h"
+#include "client/agent/verify_cell.h"
 #include "client/cell/cell_config.h"
 #include "client/remote/remote_client.h"
 #include "core/io/atomic_file.h"
 #include "core/io/io_mesh.h"
+#include "core/io/io_point_cloud.h"
 #include "core/process/buffer_reuse.h"
 #include "core/process/quiet_consoles.h"
 #include "proto/convert.h"
@@ -39,7 +42,9 @@ struct AgentArgs {
   uint64_t seed = 1;
   bool once = false;
   double poll_s = 1.0, timeout_s = 300;
-  BackoffSettings backoff;  // max_attempts 0 = keep retrying retryable errors
+  BackoffSettings backoff;              // max_attempts 0 = keep retrying retryable errors
+  std::string robot_drift, status_dir;  // simulated robot's drift "VIEW:MM"; verify's state
+  int verify_every = -1;                // parts between drift checks; -1 = cell.json's
 };
 
 template <typename T>
@@ -85,6 +90,8 @@ int Calibrate(const AgentArgs& a) {
   CellConfig cell = OrDie(ReadCellConfig(a.cell));
   const TriangleMesh gauge = OrDie(ReadMesh(cell.gauge_mesh));
   auto client = ConnectFor(a, cell);
+  if (const std::string kept = OrDie(KeepPreviousCalibration(cell)); !kept.empty())
+    spdlog::info("previous calibration kept as {}", kept);
   CalibrateCellOptions options;
   options.gauge_scans = a.gauge_scans;
   options.backoff = a.backoff;
@@ -155,6 +162,59 @@ InspectFn InspectOver(RemoteClient& client, const TriangleMesh& part,
   };
 }
 
+std::string StatusDir(const AgentArgs& a) {
+  if (!a.status_dir.empty()) return a.status_dir;
+  const std::string dir = std::filesystem::path(a.cell).parent_path().string();
+  return dir.empty() ? "." : dir;
+}
+
+// Gauge scans for a drift check: from --gauge-scans, else the simulated robot.
+GaugeScanFn GaugeScans(const AgentArgs& a, const CellConfig& cell, const TriangleMesh& gauge,
+                       const RobotDrift& drift) {
+  auto round = std::make_shared<uint64_t>(0);
+  return [&a, &cell, &gauge, drift, round](const CellViewpoint& vp) -> absl::StatusOr<PointCloud> {
+    if (!a.gauge_scans.empty()) return ReadPointCloud(a.gauge_scans + "/" + vp.name + ".pcd");
+    if (vp.name == cell.viewpoints.front().name) ++*round;
+    return SimulateGaugeScan(cell, gauge, vp, drift, a.seed * 7919 + *round);
+  };
+}
+
+// One drift check: printed, and its state written to the status folder.
+absl::StatusOr<CellVerification> VerifyAndReport(const AgentArgs& a, const CellConfig& cell,
+                                                 const MeshIndex& gauge, const GaugeScanFn& scans,
+                                                 const DriftLimits& limits) {
+  auto v = VerifyCell(cell, gauge, scans, limits);
+  if (!v.ok()) return v.status();
+  std::printf("%-8s %12s %12s %12s %10s %6s\n", "view", "part_um", "sensor_um", "rotation_deg",
+              "sigma", "state");
+  for (const auto& w : v->views) {
+    if (!w.status.ok()) {
+      std::printf("%-8s %s\n", w.name.c_str(), std::string(w.status.message()).c_str());
+      continue;
+    }
+    std::printf("%-8s %12.2f %12.2f %12.5f %10.1f %6s\n", w.name.c_str(), w.drift.at_part_um,
+                w.drift.at_sensor_um, w.drift.rotation_deg, w.drift.significance,
+                DriftClassName(w.drift.verdict));
+  }
+  std::fflush(stdout);
+  if (auto st = WriteVerificationStatus(StatusDir(a), cell, *v); !st.ok()) return st;
+  return v;
+}
+
+int Verify(const AgentArgs& a) {
+  const CellConfig cell = OrDie(ReadCellConfig(a.cell));
+  const VerifyConfig config = OrDie(VerifyConfigOf(cell));
+  const TriangleMesh gauge = OrDie(ReadMesh(cell.gauge_mesh));
+  const auto index = OrDie(MeshIndex::Build(gauge));
+  const RobotDrift drift =
+      a.robot_drift.empty() ? RobotDrift{} : OrDie(ParseRobotDrift(a.robot_drift));
+  const CellVerification v =
+      OrDie(VerifyAndReport(a, cell, *index, GaugeScans(a, cell, gauge, drift), config.limits));
+  std::printf("calibration %s: %s (state in %s/calibration_status.json)\n",
+              DriftClassName(v.verdict), v.reason.c_str(), StatusDir(a).c_str());
+  return v.verdict == DriftClass::kFail ? 3 : 0;
+}
+
 int Run(const AgentArgs& a) {
   const CellConfig cell = OrDie(ReadCellConfig(a.cell));
   const InboxLayout layout = ResolveLayout(a.paths);
@@ -164,8 +224,10 @@ int Run(const AgentArgs& a) {
   }
   spdlog::info("inbox {}, results {}, archive {}, quarantine {}", layout.inbox, layout.results,
                layout.archive, layout.quarantine);
+  const RobotDrift drift =
+      a.robot_drift.empty() ? RobotDrift{} : OrDie(ParseRobotDrift(a.robot_drift));
   if (a.simulate > 0) {
-    const auto ids = OrDie(SimulateParts(cell, layout.inbox, a.simulate, a.seed));
+    const auto ids = OrDie(SimulateParts(cell, layout.inbox, a.simulate, a.seed, drift));
     spdlog::info("simulated robot: {} parts dropped into {}", ids.size(), layout.inbox);
   }
   const TriangleMesh part = OrDie(ReadMesh(cell.part_mesh));
@@ -176,6 +238,21 @@ int Run(const AgentArgs& a) {
   hooks.on_retry = [](const std::string& id, const absl::Status& st, int calls, double) {
     spdlog::warn("{}: {} (attempt {}, retrying)", id, std::string(st.message()), calls);
   };
+  VerifyConfig verify = OrDie(VerifyConfigOf(cell));
+  if (a.verify_every >= 0) verify.every_parts = a.verify_every;
+  std::unique_ptr<MeshIndex> gauge_index;
+  std::unique_ptr<DriftMonitor> monitor;
+  TriangleMesh gauge;
+  if (verify.every_parts > 0 || verify.every_s > 0) {
+    gauge = OrDie(ReadMesh(cell.gauge_mesh));
+    gauge_index = OrDie(MeshIndex::Build(gauge));
+    monitor = std::make_unique<DriftMonitor>(
+        verify, [&a, &cell, &gauge_index, &verify, scans = GaugeScans(a, cell, gauge, drift)] {
+          spdlog::info("drift check of {} viewpoints", cell.viewpoints.size());
+          return VerifyAndReport(a, cell, *gauge_index, scans, verify.limits);
+        });
+    hooks.before_part = [&monitor](int done) { return monitor->BeforePart(done); };
+  }
   AgentSettings settings;
   settings.backoff = a.backoff;
   settings.poll_s = a.poll_s;
@@ -184,6 +261,12 @@ int Run(const AgentArgs& a) {
                   a.seed ^ static_cast<uint64_t>(::getpid()));
   const RunSummary s = agent.Run(g_stop, PrintPart);
   if (s.config_error) return 2;
+  if (!s.halted.empty()) {
+    spdlog::error(
+        "stopped inspecting: {}; {} parts left in {} (state in {}/calibration_status.json)",
+        s.halted, CompleteParts(layout.inbox).size(), layout.inbox, StatusDir(a));
+    return 4;
+  }
   std::printf("summary: %d parts done (%d pass, %d fail), ", s.done, s.pass, s.done - s.pass);
   if (s.archived_without_call > 0)
     std::printf("%d archived with earlier results, ", s.archived_without_call);
@@ -227,6 +310,16 @@ void AddRunOptions(CLI::App* run, AgentArgs& a) {
       ->check(CLI::Range(0, 10000));
   run->add_flag("--once", a.once, "process what is there, then exit");
   run->add_option("--poll", a.poll_s, "inbox poll interval, s")->check(CLI::PositiveNumber);
+  run->add_option("--verify-every", a.verify_every,
+                  "drift check before every N-th part (default: verify.every_parts in cell.json)")
+      ->check(CLI::NonNegativeNumber);
+}
+
+void AddVerifyOptions(CLI::App* cmd, AgentArgs& a) {
+  cmd->add_option("--robot-drift", a.robot_drift,
+                  "simulated robot: VIEW:MM, the sensor stands MM mm off its taught pose there");
+  cmd->add_option("--status-dir", a.status_dir,
+                  "where calibration_status.json/.prom go (default: beside cell.json)");
 }
 
 }  // namespace
@@ -248,9 +341,21 @@ int main(int argc, char** argv) {
   auto* run = app.add_subcommand("run", "Process complete parts from the inbox");
   AddConnection(run, a);
   AddRunOptions(run, a);
+  AddVerifyOptions(run, a);
+  run->add_option("--gauge-scans", a.gauge_scans,
+                  "drift checks read <viewpoint>.pcd here (default: the simulated robot scans)");
+  auto* verify = app.add_subcommand(
+      "verify",
+      "Re-scan the gauge at every viewpoint; report and classify the drift since calibration");
+  verify->add_option("--cell", a.cell, "cell.json (calibrated)")->required();
+  verify->add_option("--gauge-scans", a.gauge_scans,
+                     "folder of fresh <viewpoint>.pcd (default: the simulated robot scans)");
+  verify->add_option("--seed", a.seed, "random seed (simulated robot)");
+  AddVerifyOptions(verify, a);
   CLI11_PARSE(app, argc, argv);
   signal(SIGTERM, OnSignal);
   signal(SIGINT, OnSignal);
   if (cal->parsed()) return Calibrate(a);
+  if (verify->parsed()) return Verify(a);
   return Run(a);
 }

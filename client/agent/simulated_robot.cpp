@@ -1,6 +1,9 @@
 #include "client/agent/simulated_robot.h"
 
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <random>
 
 #include "absl/strings/str_format.h"
@@ -57,6 +60,26 @@ Eigen::Isometry3d TruePose(const CellConfig& cell, const CellViewpoint& vp) {
   return pose;
 }
 
+// TruePose, moved by the drift when it is this viewpoint's.
+Eigen::Isometry3d DriftedPose(const CellConfig& cell, const CellViewpoint& vp,
+                              const RobotDrift& drift) {
+  Eigen::Isometry3d pose = TruePose(cell, vp);
+  if (drift.view != vp.name || drift.mm == 0) return pose;
+  std::mt19937_64 rng(drift.seed);
+  std::normal_distribution<double> g;
+  const Eigen::Vector3d dir = Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized();
+  pose.pretranslate(drift.mm * dir);
+  return pose;
+}
+
+ScanOptions RobotScanOptions() {
+  ScanOptions opt;
+  opt.noise_sigma_mm = 0.015;
+  opt.pulse_fraction = 0.003;
+  opt.stripes = true;
+  return opt;
+}
+
 // Two defects on the ridge's top (a bump, then a dent); their truth as JSON.
 nlohmann::json PlantDefects(const TriangleMesh& part, std::mt19937_64& rng, ScanOptions* opt) {
   const Bounds3 b = ComputeBounds(part);
@@ -81,7 +104,8 @@ nlohmann::json PlantDefects(const TriangleMesh& part, std::mt19937_64& rng, Scan
 
 // Scans one part at every viewpoint into DIR, then truth.json, then DONE.
 absl::Status DropPart(const CellConfig& cell, const TriangleMesh& part, const fs::path& dir,
-                      ScanOptions opt, const nlohmann::json& defects, uint64_t seed, int n) {
+                      ScanOptions opt, const nlohmann::json& defects, uint64_t seed, int n,
+                      const RobotDrift& drift) {
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) return absl::PermissionDeniedError(dir.string() + ": " + ec.message());
@@ -89,7 +113,8 @@ absl::Status DropPart(const CellConfig& cell, const TriangleMesh& part, const fs
   for (std::size_t v = 0; v < cell.viewpoints.size(); ++v) {
     const CellViewpoint& vp = cell.viewpoints[v];
     opt.seed = seed * 1000003 + n * 101 + v;
-    auto scan = SimulateScan(part, cell.world_from_part, TruePose(cell, vp), intrinsics, opt);
+    auto scan =
+        SimulateScan(part, cell.world_from_part, DriftedPose(cell, vp, drift), intrinsics, opt);
     if (!scan.ok()) return scan.status();
     if (auto st = WritePointCloud((dir / (vp.name + ".pcd")).string(), scan->cloud_in_sensor);
         !st.ok())
@@ -104,9 +129,38 @@ absl::Status DropPart(const CellConfig& cell, const TriangleMesh& part, const fs
 
 }  // namespace
 
+absl::StatusOr<RobotDrift> ParseRobotDrift(const std::string& text) {
+  RobotDrift d;
+  const auto colon = text.rfind(':');
+  char* end = nullptr;
+  if (colon != std::string::npos && colon > 0) d.mm = std::strtod(text.c_str() + colon + 1, &end);
+  if (colon == std::string::npos || colon == 0 || end == text.c_str() + colon + 1 || *end != 0 ||
+      !(d.mm >= 0) || !std::isfinite(d.mm))
+    return absl::InvalidArgumentError("--robot-drift " + text + ": expected VIEW:MM, e.g. v2:0.02");
+  d.view = text.substr(0, colon);
+  return d;
+}
+
+absl::StatusOr<PointCloud> SimulateGaugeScan(const CellConfig& cell, const TriangleMesh& gauge,
+                                             const CellViewpoint& vp, const RobotDrift& drift,
+                                             uint64_t seed) {
+  ScanOptions opt = RobotScanOptions();
+  opt.seed = seed * 1000003 + std::hash<std::string>{}(vp.name) % 1000;
+  auto scan = SimulateScan(gauge, vp.world_from_gauge, DriftedPose(cell, vp, drift),
+                           IntrinsicsOf(cell), opt);
+  if (!scan.ok()) return scan.status();
+  return std::move(scan->cloud_in_sensor);
+}
+
 absl::StatusOr<std::vector<std::string>> SimulateParts(const CellConfig& cell,
                                                        const std::string& inbox, int count,
                                                        uint64_t seed) {
+  return SimulateParts(cell, inbox, count, seed, RobotDrift{});
+}
+
+absl::StatusOr<std::vector<std::string>> SimulateParts(const CellConfig& cell,
+                                                       const std::string& inbox, int count,
+                                                       uint64_t seed, const RobotDrift& drift) {
   auto part = ReadMesh(cell.part_mesh);
   if (!part.ok()) return part.status();
   std::mt19937_64 rng(seed);
@@ -115,12 +169,10 @@ absl::StatusOr<std::vector<std::string>> SimulateParts(const CellConfig& cell,
     const std::string id = absl::StrFormat("sim-%04d-%04d", seed % 10000, n);
     if (fs::exists(fs::path(inbox) / id)) continue;
     ++k;
-    ScanOptions opt;
-    opt.noise_sigma_mm = 0.015;
-    opt.pulse_fraction = 0.003;
-    opt.stripes = true;
+    ScanOptions opt = RobotScanOptions();
     const nlohmann::json defects = PlantDefects(*part, rng, &opt);
-    if (auto st = DropPart(cell, *part, fs::path(inbox) / id, opt, defects, seed, n); !st.ok())
+    if (auto st = DropPart(cell, *part, fs::path(inbox) / id, opt, defects, seed, n, drift);
+        !st.ok())
       return st;
     ids.push_back(id);
   }

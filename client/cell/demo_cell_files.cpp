@@ -11,6 +11,7 @@
 #include "core/io/io_mesh.h"
 #include "core/io/io_point_cloud.h"
 #include "core/io/io_transform.h"
+#include "core/simulation/acceptance_artefacts.h"
 
 namespace surfinspect::client {
 namespace {
@@ -141,6 +142,47 @@ nlohmann::json CellJson(const DemoCell& cell, nlohmann::json views) {
           {"error_map", {{"allowed_fraction_outside", 0.001}, {"max_distance_mm", 5.0}}}};
 }
 
+// One scan of an acceptance measurement from its viewpoint's true pose.
+absl::Status WriteAcceptanceScan(const std::string& dir, const DemoCell& cell,
+                                 const AcceptanceScene& scene, const std::string& name,
+                                 const std::string& view, const ScanOptions& scan) {
+  auto v = ViewIndex(cell, view);
+  if (!v.ok()) return v.status();
+  auto s = SimulateAcceptanceScan(cell, scene, name, cell.viewpoints[*v].world_from_sensor, scan);
+  if (!s.ok()) return s.status();
+  const std::string sub = absl::StrCat(dir, "/acceptance/scans/", name);
+  if (auto st = MakeDirectory(sub); !st.ok()) return st;
+  return WritePointCloud(absl::StrCat(sub, "/", view, ".pcd"), s->cloud_in_sensor,
+                         PcdEncoding::kBinaryCompressed);
+}
+
+// DIR/acceptance/: every measurement's scans, then artefacts.json with the
+// simulated truth of each figure beside the calibrated values.
+absl::Status WriteAcceptance(const std::string& dir, const DemoCell& cell,
+                             const ScanOptions& scan) {
+  const AcceptanceScene scene = MakeDemoAcceptance(cell);
+  const Artefacts& a = scene.artefacts;
+  std::vector<std::pair<std::string, std::string>> scans;
+  for (const auto& m : a.spheres) scans.emplace_back(m.name, m.at.view);
+  for (const auto& b : a.ball_bar) {
+    scans.emplace_back(b.name, b.a.view);
+    if (b.cross_view()) scans.emplace_back(b.name, b.b.view);
+  }
+  for (const auto& p : a.plates) scans.emplace_back(p.name, p.at.view);
+  for (const auto& [name, view] : scans)
+    if (auto st = WriteAcceptanceScan(dir, cell, scene, name, view, scan); !st.ok()) return st;
+  nlohmann::json j = ArtefactsToJson(a);
+  j["simulation_truth"] = {
+      {"sphere_diameter_mm", scene.true_sphere_diameter_mm},
+      {"ball_bar_length_mm", scene.true_length_mm},
+      {"PS_mm", scene.true_sphere_diameter_mm - a.sphere_diameter_mm},
+      {"SD_mm", scene.true_length_mm - a.ball_bar_length_mm},
+      {"PF_mm_form", 0.0},
+      {"F_mm_form", scene.true_flatness_mm},
+      {"note", "PF and F of noisy scans also hold the sensor noise, as the guideline intends"}};
+  return WriteStringAtomically(dir + "/acceptance/artefacts.json", j.dump(2) + "\n");
+}
+
 }  // namespace
 
 absl::Status WriteDemoCell(const std::string& dir, const DemoCell& cell,
@@ -163,7 +205,11 @@ absl::Status WriteDemoCell(const std::string& dir, const DemoCell& cell,
                                       CellJson(cell, *std::move(views)).dump(2) + "\n");
       !st.ok())
     return st;
-  return WriteStringAtomically(dir + "/truth/parts.json", nlohmann::json(parts).dump(2) + "\n");
+  if (auto st =
+          WriteStringAtomically(dir + "/truth/parts.json", nlohmann::json(parts).dump(2) + "\n");
+      !st.ok())
+    return st;
+  return options.acceptance ? WriteAcceptance(dir, cell, options.scan) : absl::OkStatus();
 }
 
 }  // namespace surfinspect::client

@@ -6,6 +6,9 @@
 //   DIR/scans/part-NNN/<view>.pcd         production scans with planted defects
 //   DIR/truth/part-NNN/<view>.json        outlier pixels of each scan
 //   DIR/truth/parts.json                  the planted defects of every part
+//   DIR/acceptance/artefacts.json         acceptance artefacts (core/acceptance/artefacts.h)
+//                                         with their simulated truth
+//   DIR/acceptance/scans/<name>/<view>.pcd   their scans (binary_compressed)
 // Scans are organized binary PCD in the sensor frame. core/simulation makes
 // the data; this file only writes it.
 #pragma once
@@ -19,7 +22,8 @@ namespace surfinspect::client {
 
 struct DemoWriteOptions {
   int parts = 1;
-  ScanOptions scan;  // noise/outliers for all scans; production scans add defects
+  ScanOptions scan;        // noise/outliers for all scans; production scans add defects
+  bool acceptance = true;  // write DIR/acceptance/ (core/simulation/acceptance_artefacts.h)
 };
 
 absl::Status WriteDemoCell(const std::string& dir, const DemoCell& cell,

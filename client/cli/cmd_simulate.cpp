@@ -92,6 +92,8 @@ void WriteCell(const std::string& out, int parts, uint64_t seed) {
   std::printf("  gauge_scans/v1..v5.pcd     calibration scans of the gauge\n");
   std::printf("  scans/part-NNN/v1..v5.pcd  production scans with planted dents/bumps\n");
   std::printf("  truth/                     outlier pixels and planted defects (JSON)\n");
+  std::printf(
+      "  acceptance/                artefact scans + artefacts.json (surfinspect acceptance)\n");
 }
 
 }  // namespace

@@ -53,31 +53,6 @@ void AddBox(TriangleMesh& m, const Eigen::Vector3f& lo, const Eigen::Vector3f& h
   for (const auto& f : faces) m.triangles.push_back({base + f[0], base + f[1], base + f[2]});
 }
 
-void AddSphere(TriangleMesh& m, const Eigen::Vector3d& c, double r, int slices, int stacks) {
-  const auto base = static_cast<uint32_t>(m.vertices.size());
-  m.vertices.push_back((c + Eigen::Vector3d(0, 0, r)).cast<float>());  // north pole
-  for (int s = 1; s < stacks; ++s) {
-    const double phi = M_PI * s / stacks;
-    for (int k = 0; k < slices; ++k) {
-      const double th = 2 * M_PI * k / slices;
-      m.vertices.push_back((c + r * Eigen::Vector3d(std::sin(phi) * std::cos(th),
-                                                    std::sin(phi) * std::sin(th), std::cos(phi)))
-                               .cast<float>());
-    }
-  }
-  m.vertices.push_back((c - Eigen::Vector3d(0, 0, r)).cast<float>());  // south pole
-  const uint32_t south = static_cast<uint32_t>(m.vertices.size() - 1);
-  auto ring = [&](int s, int k) { return base + 1 + uint32_t((s - 1) * slices + (k % slices)); };
-  for (int k = 0; k < slices; ++k) m.triangles.push_back({base, ring(1, k), ring(1, k + 1)});
-  for (int s = 1; s + 1 < stacks; ++s)
-    for (int k = 0; k < slices; ++k) {
-      m.triangles.push_back({ring(s, k), ring(s + 1, k), ring(s + 1, k + 1)});
-      m.triangles.push_back({ring(s, k), ring(s + 1, k + 1), ring(s, k + 1)});
-    }
-  for (int k = 0; k < slices; ++k)
-    m.triangles.push_back({south, ring(stacks - 1, k + 1), ring(stacks - 1, k)});
-}
-
 Eigen::Isometry3d Pose(const Eigen::Vector3d& t, double yaw_deg) {
   Eigen::Isometry3d p = Eigen::Isometry3d::Identity();
   p.linear() = Eigen::AngleAxisd(yaw_deg * M_PI / 180, Eigen::Vector3d::UnitZ()).toRotationMatrix();
@@ -102,6 +77,31 @@ double RidgeZ(double x, double length) {
 }
 
 }  // namespace
+
+void AddUvSphere(TriangleMesh& m, const Eigen::Vector3d& c, double r, int slices, int stacks) {
+  const auto base = static_cast<uint32_t>(m.vertices.size());
+  m.vertices.push_back((c + Eigen::Vector3d(0, 0, r)).cast<float>());  // north pole
+  for (int s = 1; s < stacks; ++s) {
+    const double phi = M_PI * s / stacks;
+    for (int k = 0; k < slices; ++k) {
+      const double th = 2 * M_PI * k / slices;
+      m.vertices.push_back((c + r * Eigen::Vector3d(std::sin(phi) * std::cos(th),
+                                                    std::sin(phi) * std::sin(th), std::cos(phi)))
+                               .cast<float>());
+    }
+  }
+  m.vertices.push_back((c - Eigen::Vector3d(0, 0, r)).cast<float>());  // south pole
+  const uint32_t south = static_cast<uint32_t>(m.vertices.size() - 1);
+  auto ring = [&](int s, int k) { return base + 1 + uint32_t((s - 1) * slices + (k % slices)); };
+  for (int k = 0; k < slices; ++k) m.triangles.push_back({base, ring(1, k), ring(1, k + 1)});
+  for (int s = 1; s + 1 < stacks; ++s)
+    for (int k = 0; k < slices; ++k) {
+      m.triangles.push_back({ring(s, k), ring(s + 1, k), ring(s + 1, k + 1)});
+      m.triangles.push_back({ring(s, k), ring(s + 1, k + 1), ring(s, k + 1)});
+    }
+  for (int k = 0; k < slices; ++k)
+    m.triangles.push_back({south, ring(stacks - 1, k + 1), ring(stacks - 1, k)});
+}
 
 TriangleMesh MakePillarMesh(double length_mm) {
   const double run = kHeight / std::tan(kWallDeg * M_PI / 180);
@@ -135,9 +135,9 @@ TriangleMesh MakeGaugeMesh() {
   TriangleMesh m;
   AddBox(m, {-80, -60, -10}, {80, 60, 0});
   AddBox(m, {10, -55, 0}, {75, 55, 15});  // inset: no edge shared with the plate
-  AddSphere(m, {-45, -25, 12}, 12, 48, 24);
-  AddSphere(m, {-30, 30, 18}, 18, 48, 24);
-  AddSphere(m, {45, 5, 15 + 20}, 20, 48, 24);
+  AddUvSphere(m, {-45, -25, 12}, 12, 48, 24);
+  AddUvSphere(m, {-30, 30, 18}, 18, 48, 24);
+  AddUvSphere(m, {45, 5, 15 + 20}, 20, 48, 24);
   return m;
 }
 

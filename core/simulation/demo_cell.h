@@ -47,6 +47,11 @@ DemoCell MakeDemoCell(const DemoCellOptions& options = {});
 // The pillar part alone, e.g. for tests (hat channel along +x, top ridge at
 // the highest z, centred on the origin).
 TriangleMesh MakePillarMesh(double length_mm = 300.0);
+// A UV sphere of radius r (mm) about c: `slices` around the z axis and
+// `stacks` from pole to pole; vertices on the sphere, outward CCW normals.
+// Its facets lie inside the sphere by at most r (1 - cos(pi / min(slices, 2 stacks)))
+// at their centres.
+void AddUvSphere(TriangleMesh& mesh, const Eigen::Vector3d& c, double r, int slices, int stacks);
 // The calibration gauge alone (plate in z <= 0, spheres and steps above).
 TriangleMesh MakeGaugeMesh();
 
