@@ -175,6 +175,7 @@ PartReport CellAgent::InspectAndStore(const std::string& id, const std::vector<V
         id, absl::StrCat(absl::StatusCodeToString(rr.status.code()), ": ", rr.status.message()));
   } else {
     auto outputs = OutputsFromRemote(*result);
+    if (outputs.ok()) outputs->cell = cell_.name;
     absl::Status written =
         outputs.ok() ? WritePartOutputs((fs::path(layout_.results) / id).string(), *outputs)
                      : outputs.status();

@@ -7,6 +7,7 @@
 #include "absl/strings/str_format.h"
 #include "core/errormap/error_map_output.h"
 #include "core/io/atomic_file.h"
+#include "core/report/qif_results.h"
 #include "proto/convert.h"
 
 namespace surfinspect::client {
@@ -26,6 +27,17 @@ absl::Status FillFromReport(PartOutputs& o) {
     if (!(o.tolerance_mm > 0)) return absl::DataLossError("report lacks tolerance.band_mm");
   }
   return absl::OkStatus();
+}
+
+// QIF 3.0 Results beside report.json; the measured points stay in errormap.ply.
+QifContext QifContextOf(const PartOutputs& o) {
+  QifContext c;
+  c.part_id = o.part_id;
+  c.cell = o.cell.empty() ? "cell" : o.cell;
+  c.points_uri = "errormap.ply";
+  c.points_count = o.merged_in_world.size();
+  c.time_created = QifTimeNow();
+  return c;
 }
 
 }  // namespace
@@ -117,6 +129,8 @@ absl::Status WritePartOutputs(const std::string& dir, const PartOutputs& o) {
   if (auto st = WriteErrorMapCsv(dir + "/deviations.csv", o.merged_in_world, view); !st.ok())
     return st;
   if (auto st = WriteStringAtomically(dir + "/errormap.png", o.png); !st.ok()) return st;
+  if (auto st = WriteQifResults(dir + "/result.qif", o.report_json, QifContextOf(o)); !st.ok())
+    return st;
   // The report last: its presence means the part's results are complete.
   return WriteStringAtomically(dir + "/report.json", o.report_json);
 }

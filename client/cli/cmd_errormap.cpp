@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "client/cell/cell_config.h"
@@ -20,6 +21,7 @@
 #include "core/io/io_point_cloud.h"
 #include "core/io/io_transform.h"
 #include "core/pipeline/plan_evaluation.h"
+#include "core/report/qif_results.h"
 #include "core/types/transform.h"
 #include "proto/convert.h"
 
@@ -27,7 +29,7 @@ namespace surfinspect::cli {
 namespace {
 
 struct ErrorMapArgs {
-  std::string cloud, mesh, world_from_part, out, csv, report, png, plan;
+  std::string cloud, mesh, world_from_part, out, csv, report, png, plan, qif;
   std::string frame = "part";
   std::string png_axis = "auto";
   ErrorMapSettings settings;
@@ -134,6 +136,20 @@ void PrintSummary(const ErrorMapArgs& a, const ErrorMapRun& run) {
               a.png.c_str());
 }
 
+// QIF 3.0 Results: the part is the cloud's file stem, the points are the PLY
+// (its path relative to the QIF file).
+void WriteQif(const ErrorMapArgs& a, const ErrorMapRun& run, std::size_t points) {
+  namespace fs = std::filesystem;
+  QifContext c;
+  c.part_id = fs::path(a.cloud).stem().string();
+  c.cell = "surfinspect errormap";
+  c.part_model = fs::path(a.mesh).filename().string();
+  c.points_uri = fs::absolute(a.out).lexically_relative(fs::absolute(a.qif).parent_path()).string();
+  c.points_count = points;
+  c.time_created = QifTimeNow();
+  Check(WriteQifResults(a.qif, run.report.dump(), c));
+}
+
 void RunErrorMap(const ErrorMapArgs& a) {
   auto t0 = std::chrono::steady_clock::now();
   const PointCloud cloud_in_world = Take(ReadPointCloud(a.cloud));
@@ -164,6 +180,7 @@ void RunErrorMap(const ErrorMapArgs& a) {
   Check(WriteErrorMapPly(a.out, written, run.result, a.frame));
   if (!a.csv.empty()) Check(WriteErrorMapCsv(a.csv, written, run.result));
   if (!a.png.empty()) Check(WriteStringAtomically(a.png, run.png_bytes));
+  if (!a.qif.empty()) WriteQif(a, run, written.size());
   if (!a.report.empty()) {
     run.report["inputs"] = {
         {"cloud", a.cloud}, {"mesh", a.mesh}, {"world_from_part", a.world_from_part}};
@@ -190,6 +207,9 @@ void AddErrorMapCommand(CLI::App& app) {
   cmd->add_option("--csv", a->csv, "CSV x,y,z,deviation, one row per input point");
   cmd->add_option("--report", a->report, "JSON report");
   cmd->add_option("--png", a->png, "PNG: map, colour bar, histogram, defect ids");
+  cmd->add_option("--qif", a->qif,
+                  "QIF 3.0 Results: characteristics, verdicts, the PLY as the measured points "
+                  "(docs/integration.md)");
   cmd->add_option("--plan", a->plan,
                   "inspection plan JSON: regions, comparison points, defect detection "
                   "(docs/inspection-plan.md); its default band is +-tolerance");

@@ -62,6 +62,7 @@ void Inspect(const InspectArgs& a) {
         Take(InspectPart(*index, cell.world_from_part, std::move(views), settings));
     outputs = Take(client::OutputsFromLocal(part_id, r, settings, cell.world_from_part, part));
   }
+  outputs.cell = cell.name;
   Check(client::WritePartOutputs(a.out, outputs));
   std::printf("%s: %s  (min %.3f mm, max %.3f mm)  -> %s\n", part_id.c_str(),
               outputs.verdict.c_str(), outputs.min_mm, outputs.max_mm, a.out.c_str());
