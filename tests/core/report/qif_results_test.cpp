@@ -94,7 +94,9 @@ TEST(QifResults, EveryCharacteristicReadsBackAsTheReportSays) {
     const double lower = c["tolerance_mm"]["lower"], upper = c["tolerance_mm"]["upper"];
     EXPECT_EQ(def.child("ToleranceValue").text().as_double(), upper - lower);
     EXPECT_EQ(!def.child("OuterDisposition").empty(), lower != -upper);
-    if (lower != -upper) EXPECT_EQ(def.child("OuterDisposition").text().as_double(), upper);
+    if (lower != -upper) {
+      EXPECT_EQ(def.child("OuterDisposition").text().as_double(), upper);
+    }
     if (c["points"] == 0) {
       EXPECT_TRUE(m.child("Value").empty());
     } else {
