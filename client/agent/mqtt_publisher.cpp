@@ -216,8 +216,9 @@ absl::StatusOr<std::unique_ptr<MqttPublisher>> MqttPublisher::Start(const MqttSe
                      [&] { return s.answered; }) &&
       rc == MOSQ_ERR_SUCCESS)
     s.Say(s.log.error,
-          absl::StrCat("mqtt: no answer from the broker ", s.url, " within ", first_connect_s,
-                       " s; inspection goes on, events are sent when it answers"));
+          absl::StrCat("mqtt: cannot reach the broker ", s.url, ": no answer within ",
+                       first_connect_s,
+                       " s; inspection goes on, events are sent when it is reachable"));
   return p;
 }
 
