@@ -11,6 +11,7 @@ usage: mqtt_e2e_test.py BIN_DIR [unittest args]
 """
 import json
 import os
+import re
 import shutil
 import signal
 import socket
@@ -22,6 +23,34 @@ import unittest
 
 BIN = None
 KEEPALIVE = 5  # s; the broker fires the Will after 1.5 x this without traffic
+
+
+DOC = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "docs", "integration.md")
+
+
+def doc_samples():
+    """docs/integration.md's ```LANG sample=NAME blocks, by name."""
+    with open(DOC) as f:
+        return {m.group(2): m.group(3) for m in re.finditer(r"```(\w+) sample=([\w-]+)\n(.*?)```", f.read(), re.S)}
+
+
+def json_type(v):
+    return "number" if isinstance(v, (int, float)) and not isinstance(v, bool) else type(v).__name__
+
+
+def assert_like_sample(test, sample, real, where):
+    """Every key of the real payload is in the sample, with the same JSON type
+    (null stands for a number that may be missing); nested objects too."""
+    test.assertEqual(sorted(real), sorted(sample), f"{where}: keys")
+    for key, value in real.items():
+        s = sample[key]
+        if value is None or s is None:
+            continue
+        test.assertEqual(json_type(s), json_type(value), f"{where}.{key}")
+        if isinstance(value, dict):
+            assert_like_sample(test, s, value, f"{where}.{key}")
+        if isinstance(value, list) and value and s and isinstance(value[0], dict):
+            assert_like_sample(test, s[0], value[0], f"{where}.{key}[0]")
 
 
 def free_port():
@@ -243,6 +272,19 @@ class MqttTests(unittest.TestCase):
         states = [p["state"] for t, p in msgs if t.endswith("/status")]
         self.assertEqual((states[0], states[-1]), ("online", "offline"))
         self.assertEqual(retained_status(broker), "offline")
+        # The samples in docs/integration.md are true of this output.
+        samples = doc_samples()
+        failing = [p for t, p in msgs if t.endswith("/result") and p["failed"]]
+        self.assertTrue(failing, "no failing part to check the sample's failed[] against")
+        assert_like_sample(self, json.loads(samples["mqtt-result"]), failing[0], "result")
+        assert_like_sample(self, json.loads(samples["mqtt-started"]),
+                           [p for t, p in msgs if t.endswith("/started")][0], "started")
+        assert_like_sample(self, json.loads(samples["mqtt-status"]),
+                           [p for t, p in msgs if t.endswith("/status")][-1], "status")
+        documented = {l.split()[0].split("/", 2)[2] for l in samples["folder"].splitlines()
+                      if l.startswith("RESULTS/<part>/")}
+        for part in parts:
+            self.assertEqual(sorted(os.listdir(os.path.join(self.dir, "results", part))), sorted(documented))
 
     def test_status_online_then_offline_by_the_last_will_after_kill_9(self):
         broker = self.broker()

@@ -13,6 +13,7 @@ usage: qif_demo_test.py BIN_DIR SOURCE_DIR
 """
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -53,6 +54,27 @@ def check_against_report(qif_path, report):
     uri = root.find(".//q:ExternalFileReference/q:URI", NS).text
     assert os.path.isfile(os.path.join(os.path.dirname(qif_path), uri)), uri
     return len(chars)
+
+
+def element_paths(root):
+    """Every element's path of tag names (namespace dropped) below the root."""
+    paths = set()
+
+    def walk(e, prefix):
+        path = prefix + "/" + e.tag.split("}")[-1]
+        paths.add(path)
+        for child in e:
+            walk(child, path)
+    walk(root, "")
+    return paths
+
+
+def check_doc_sample(source, qif_path):
+    """docs/integration.md's QIF sample: each of its element paths is in a real file."""
+    with open(os.path.join(source, "docs", "integration.md")) as f:
+        sample = re.search(r"```xml sample=qif\n(.*?)```", f.read(), re.S).group(1)
+    missing = element_paths(ET.fromstring(sample)) - element_paths(ET.parse(qif_path).getroot())
+    assert not missing, f"docs/integration.md's QIF sample has paths no real file has: {sorted(missing)}"
 
 
 def main():
@@ -104,6 +126,8 @@ def main():
             with open(report) as f:
                 n = check_against_report(qif, json.load(f))
             print(f"{qif}: {n} characteristics equal the report's")
+        check_doc_sample(source, runs[0][0])
+        print("docs/integration.md's QIF sample: every element path occurs in", runs[0][0])
     finally:
         if server:
             server.kill()
