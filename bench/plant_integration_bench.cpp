@@ -29,6 +29,7 @@ extern char** environ;
 namespace {
 
 using namespace surfinspect;
+using namespace surfinspect::client;
 using Clock = std::chrono::steady_clock;
 namespace fs = std::filesystem;
 

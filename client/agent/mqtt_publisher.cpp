@@ -112,14 +112,19 @@ void OnDisconnect(mosquitto*, void* obj, int rc) {
 
 void OnPublish(mosquitto*, void* obj, int mid) {
   auto* s = static_cast<MqttPublisher::State*>(obj);
-  std::lock_guard<std::mutex> lock(s->mu);
-  auto it = s->inflight.find(mid);
-  if (it == s->inflight.end()) return;
-  if (!it->second.empty()) {
-    if (auto st = WriteStringAtomically(it->second, ""); !st.ok())
-      s->Say(s->log.warn, absl::StrCat("mqtt: ", st.message()));
+  std::string mark;
+  {
+    std::lock_guard<std::mutex> lock(s->mu);
+    auto it = s->inflight.find(mid);
+    if (it == s->inflight.end()) return;
+    mark = std::move(it->second);
+    s->inflight.erase(it);
   }
-  s->inflight.erase(it);
+  // Outside the lock: the agent's listeners never wait for this file. It
+  // needs no fsync: a mark lost to a power cut only means one more copy.
+  if (!mark.empty() && !std::ofstream(mark).good())
+    s->Say(s->log.warn, absl::StrCat("mqtt: cannot write ", mark));
+  std::lock_guard<std::mutex> lock(s->mu);
   s->cv.notify_all();
 }
 
