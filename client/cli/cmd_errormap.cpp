@@ -146,6 +146,7 @@ void WriteQif(const ErrorMapArgs& a, const ErrorMapRun& run, std::size_t points)
   c.part_model = fs::path(a.mesh).filename().string();
   c.points_uri = fs::absolute(a.out).lexically_relative(fs::absolute(a.qif).parent_path()).string();
   c.points_count = points;
+  c.points_frame = a.frame;
   c.time_created = QifTimeNow();
   Check(WriteQifResults(a.qif, run.report.dump(), c));
 }

@@ -185,8 +185,9 @@ void AddResults(pugi::xml_node doc, const std::vector<Characteristic>& cs,
       Counted(mr, "ExternalFileReferences", 1).append_child("ExternalFileReference");
   Text(file, "URI", ctx.points_uri);
   Text(file.append_child("FileSpec"), "OtherFileSpec",
-       "PLY 1.0 binary_little_endian: vertex x y z (float, mm, world frame), "
-       "scalar_deviation (float, mm, signed), red green blue (uchar)");
+       absl::StrCat("PLY 1.0 binary_little_endian: vertex x y z (float, mm, ", ctx.points_frame,
+                    " frame), deviation (float, mm, signed, NaN unmatched), red green blue "
+                    "(uchar)"));
   Text(file, "Description",
        absl::StrCat("measured points of part ", ctx.part_id,
                     " with their signed deviation from "

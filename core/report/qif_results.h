@@ -49,6 +49,7 @@ struct QifContext {
   std::string sensor = "robot-carried 2.5D area sensor";  // MeasurementDevice Description
   std::string points_uri = "errormap.ply";  // measured points, relative to the QIF file
   std::size_t points_count = 0;             // points in that file
+  std::string points_frame = "world";       // the frame of its coordinates
   std::string time_created;                 // xs:dateTime (UTC, "...Z"); empty: omitted
 };
 

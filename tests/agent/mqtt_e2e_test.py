@@ -300,6 +300,19 @@ class MqttTests(unittest.TestCase):
             time.sleep(0.2)
         print(f"offline {time.time() - killed:.1f} s after kill -9 (keep-alive {KEEPALIVE} s)", file=sys.stderr)
 
+    def test_an_unusable_calibration_is_the_retained_status(self):
+        broker = self.broker()
+        path = os.path.join(self.dir, "cell", "cell.json")
+        with open(path) as f:
+            cell = json.load(f)
+        del cell["viewpoints"][1]["world_from_sensor"]
+        with open(path, "w") as f:
+            json.dump(cell, f)
+        code, out, err = self.agent("--mqtt", f"tcp://127.0.0.1:{broker.port}", "--simulate", "1", "--once")
+        self.assertEqual(code, 2, err)
+        self.assertIn("is not calibrated", err)
+        self.assertEqual(retained_status(broker), "calibration_expired")
+
     def test_broker_stopped_during_a_part_and_restarted_5_s_later(self):
         broker = self.broker(persistence=True)
         sub = self.subscriber(broker)
