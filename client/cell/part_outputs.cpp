@@ -40,6 +40,18 @@ QifContext QifContextOf(const PartOutputs& o) {
   return c;
 }
 
+// QIF is mapped from a surfinspect.report/2 (its characteristics); a report
+// of another schema (from a server that predates it) gets no result.qif.
+absl::Status WriteQif(const std::string& path, const PartOutputs& o) {
+  auto xml = QifResultsXml(o.report_json, QifContextOf(o));
+  if (!xml.ok()) {
+    const nlohmann::json j = nlohmann::json::parse(o.report_json, nullptr, false);
+    const bool report2 = j.is_object() && j.value("schema", "") == "surfinspect.report/2";
+    return report2 ? xml.status() : absl::OkStatus();
+  }
+  return WriteStringAtomically(path, *xml);
+}
+
 }  // namespace
 
 std::vector<std::string> FailedLines(const CharacteristicsResult& characteristics) {
@@ -129,8 +141,7 @@ absl::Status WritePartOutputs(const std::string& dir, const PartOutputs& o) {
   if (auto st = WriteErrorMapCsv(dir + "/deviations.csv", o.merged_in_world, view); !st.ok())
     return st;
   if (auto st = WriteStringAtomically(dir + "/errormap.png", o.png); !st.ok()) return st;
-  if (auto st = WriteQifResults(dir + "/result.qif", o.report_json, QifContextOf(o)); !st.ok())
-    return st;
+  if (auto st = WriteQif(dir + "/result.qif", o); !st.ok()) return st;
   // The report last: its presence means the part's results are complete.
   return WriteStringAtomically(dir + "/report.json", o.report_json);
 }
