@@ -222,7 +222,7 @@ class MqttTests(unittest.TestCase):
                "--mqtt-keepalive", str(KEEPALIVE), *extra]
         proc = subprocess.Popen(cmd, cwd=self.dir, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         if not wait:
-            self.stoppers.append(lambda: (proc.poll() is None and proc.kill(), proc.wait()))
+            self.stoppers.append(lambda: (proc.poll() is None and proc.kill(), proc.communicate()))
             return proc
         out, err = proc.communicate(timeout=400)
         return proc.returncode, out, err
