@@ -17,6 +17,7 @@
 #include "absl/strings/ascii.h"
 #include "client/agent/agent.h"
 #include "client/agent/calibrate_cell.h"
+#include "client/agent/mqtt_publisher.h"
 #include "client/agent/simulated_robot.h"
 #include "client/agent/verify_cell.h"
 #include "client/cell/cell_config.h"
@@ -45,6 +46,7 @@ struct AgentArgs {
   BackoffSettings backoff;              // max_attempts 0 = keep retrying retryable errors
   std::string robot_drift, status_dir;  // simulated robot's drift "VIEW:MM"; verify's state
   int verify_every = -1;                // parts between drift checks; -1 = cell.json's
+  MqttSettings mqtt;                    // flags; each set one overrides cell.json's "mqtt" block
 };
 
 template <typename T>
@@ -215,6 +217,30 @@ int Verify(const AgentArgs& a) {
   return v.verdict == DriftClass::kFail ? 3 : 0;
 }
 
+// MQTT events when --mqtt or cell.json's "mqtt" names a broker; a bad
+// setting stops the agent before it starts.
+std::unique_ptr<MqttPublisher> StartMqtt(const AgentArgs& a, const CellConfig& cell,
+                                         const InboxLayout& layout) {
+  MqttSettings s = OrDie(MqttSettingsFromCell(cell));
+  const MqttSettings& f = a.mqtt;
+  const MqttSettings defaults;
+  for (auto [flag, field] : {std::pair{&f.url, &s.url},
+                             {&f.username, &s.username},
+                             {&f.password_file, &s.password_file},
+                             {&f.tls_ca, &s.tls_ca},
+                             {&f.tls_cert, &s.tls_cert},
+                             {&f.tls_key, &s.tls_key},
+                             {&f.client_id, &s.client_id}})
+    if (!flag->empty()) *field = *flag;
+  if (f.topic_prefix != defaults.topic_prefix) s.topic_prefix = f.topic_prefix;
+  if (f.keepalive_s != defaults.keepalive_s) s.keepalive_s = f.keepalive_s;
+  if (s.url.empty()) return nullptr;
+  MqttLog log{[](const std::string& m) { spdlog::info("{}", m); },
+              [](const std::string& m) { spdlog::warn("{}", m); },
+              [](const std::string& m) { spdlog::error("{}", m); }};
+  return OrDie(MqttPublisher::Start(s, cell.name, layout.results, std::move(log)));
+}
+
 int Run(const AgentArgs& a) {
   const CellConfig cell = OrDie(ReadCellConfig(a.cell));
   const InboxLayout layout = ResolveLayout(a.paths);
@@ -233,8 +259,14 @@ int Run(const AgentArgs& a) {
   const TriangleMesh part = OrDie(ReadMesh(cell.part_mesh));
   const std::optional<InspectionPlan> plan = OrDie(PlanOf(cell, part, cell.error_map));
   auto client = ConnectFor(a, cell);
+  std::unique_ptr<MqttPublisher> mqtt = StartMqtt(a, cell, layout);
   AgentHooks hooks;
   hooks.inspect = InspectOver(*client, part, plan);
+  if (mqtt) {
+    hooks.on_started.push_back([&mqtt](const std::string& id) { mqtt->OnStarted(id); });
+    hooks.on_stored.push_back(
+        [&mqtt](const std::string& id, const std::string& dir) { mqtt->OnStored(id, dir); });
+  }
   hooks.on_retry = [](const std::string& id, const absl::Status& st, int calls, double) {
     spdlog::warn("{}: {} (attempt {}, retrying)", id, std::string(st.message()), calls);
   };
@@ -259,7 +291,13 @@ int Run(const AgentArgs& a) {
   settings.once = a.once;
   CellAgent agent(cell, layout, settings, std::move(hooks),
                   a.seed ^ static_cast<uint64_t>(::getpid()));
-  const RunSummary s = agent.Run(g_stop, PrintPart);
+  const RunSummary s = agent.Run(g_stop, [&mqtt](const PartReport& r) {
+    PrintPart(r);
+    if (mqtt && r.outcome == PartOutcome::kConfigError) mqtt->CalibrationExpired(r.message);
+  });
+  // A failed drift check makes the calibration unusable, as a missing one does.
+  if (mqtt && !s.halted.empty()) mqtt->CalibrationExpired(s.halted);
+  if (mqtt) mqtt->Stop();
   if (s.config_error) return 2;
   if (!s.halted.empty()) {
     spdlog::error(
@@ -313,6 +351,22 @@ void AddRunOptions(CLI::App* run, AgentArgs& a) {
   run->add_option("--verify-every", a.verify_every,
                   "drift check before every N-th part (default: verify.every_parts in cell.json)")
       ->check(CLI::NonNegativeNumber);
+  MqttSettings& m = a.mqtt;
+  run->add_option("--mqtt", m.url,
+                  "publish events to this broker: tcp://HOST:1883 or mqtts://HOST:8883 "
+                  "(default: mqtt.url in cell.json; docs/integration.md)");
+  run->add_option("--mqtt-topic-prefix", m.topic_prefix, "topics PREFIX/<cell>/...")
+      ->default_val(m.topic_prefix);
+  run->add_option("--mqtt-username", m.username, "MQTT user name");
+  run->add_option("--mqtt-password-file", m.password_file, "file whose first line is the password");
+  run->add_option("--mqtt-ca", m.tls_ca, "PEM CA of the broker's certificate (mqtts://)");
+  run->add_option("--mqtt-cert", m.tls_cert, "client certificate (mqtts://)");
+  run->add_option("--mqtt-key", m.tls_key, "client key (mqtts://)");
+  run->add_option("--mqtt-keepalive", m.keepalive_s,
+                  "keep-alive, s; the broker publishes 'offline' ~1.5 x this after a crash")
+      ->default_val(m.keepalive_s);
+  run->add_option("--mqtt-client-id", m.client_id,
+                  "persistent-session client id (default surfinspect-agent-<cell>)");
 }
 
 void AddVerifyOptions(CLI::App* cmd, AgentArgs& a) {

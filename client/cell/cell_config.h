@@ -16,6 +16,8 @@
 //                                           ("plan.json") or an inline object
 //                                           (docs/inspection-plan.md)
 //   server{target, tls_ca, tls_cert, tls_key, token_file}   optional
+//   mqtt{url, topic_prefix, ...}            optional plant events, read by
+//                                           client/agent/mqtt_events.h
 // Transforms are {"matrix": [[...]...]} (row-major, mm).
 #pragma once
 

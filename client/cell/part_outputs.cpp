@@ -9,6 +9,7 @@
 #include "core/io/atomic_file.h"
 #include "core/report/html_report.h"
 #include "core/report/pdf_report.h"
+#include "core/report/qif_results.h"
 #include "core/types/transform.h"
 #include "proto/convert.h"
 
@@ -57,6 +58,29 @@ absl::Status WriteReportHtml(const std::string& path, const PartOutputs& o) {
   in.mesh_in_part = o.mesh_in_part.get();
   in.context = {o.part_id, o.cell, o.viewpoints};
   return WriteHtmlReport(path, in);
+}
+
+// QIF 3.0 Results beside report.json; the measured points stay in errormap.ply.
+QifContext QifContextOf(const PartOutputs& o) {
+  QifContext c;
+  c.part_id = o.part_id;
+  c.cell = o.cell.empty() ? "cell" : o.cell;
+  c.points_uri = "errormap.ply";
+  c.points_count = o.merged_in_world.size();
+  c.time_created = QifTimeNow();
+  return c;
+}
+
+// QIF is mapped from a surfinspect.report/2 (its characteristics); a report
+// of another schema (from a server that predates it) gets no result.qif.
+absl::Status WriteQif(const std::string& path, const PartOutputs& o) {
+  auto xml = QifResultsXml(o.report_json, QifContextOf(o));
+  if (!xml.ok()) {
+    const nlohmann::json j = nlohmann::json::parse(o.report_json, nullptr, false);
+    const bool report2 = j.is_object() && j.value("schema", "") == "surfinspect.report/2";
+    return report2 ? xml.status() : absl::OkStatus();
+  }
+  return WriteStringAtomically(path, *xml);
 }
 
 }  // namespace
@@ -151,6 +175,7 @@ absl::Status WritePartOutputs(const std::string& dir, const PartOutputs& o) {
   if (auto st = WriteStringAtomically(dir + "/errormap.png", o.png); !st.ok()) return st;
   if (auto st = WritePartPdf(dir + "/report.pdf", o); !st.ok()) return st;
   if (auto st = WriteReportHtml(dir + "/report.html", o); !st.ok()) return st;
+  if (auto st = WriteQif(dir + "/result.qif", o); !st.ok()) return st;
   // The report last: its presence means the part's results are complete.
   return WriteStringAtomically(dir + "/report.json", o.report_json);
 }

@@ -23,6 +23,7 @@
 #include "core/pipeline/plan_evaluation.h"
 #include "core/report/html_report.h"
 #include "core/report/pdf_report.h"
+#include "core/report/qif_results.h"
 #include "core/types/transform.h"
 #include "proto/convert.h"
 
@@ -30,7 +31,7 @@ namespace surfinspect::cli {
 namespace {
 
 struct ErrorMapArgs {
-  std::string cloud, mesh, world_from_part, out, csv, report, png, pdf, plan, part_id, html;
+  std::string cloud, mesh, world_from_part, out, csv, report, png, pdf, plan, part_id, html, qif;
   std::string frame = "part";
   std::string png_axis = "auto";
   ErrorMapSettings settings;
@@ -160,6 +161,21 @@ void WriteHtml(const ErrorMapArgs& a, const ErrorMapRun& run, const PointCloud& 
   Check(WriteHtmlReport(a.html, in));
 }
 
+// QIF 3.0 Results: the part is the cloud's file stem, the points are the PLY
+// (its path relative to the QIF file).
+void WriteQif(const ErrorMapArgs& a, const ErrorMapRun& run, std::size_t points) {
+  namespace fs = std::filesystem;
+  QifContext c;
+  c.part_id = fs::path(a.cloud).stem().string();
+  c.cell = "surfinspect errormap";
+  c.part_model = fs::path(a.mesh).filename().string();
+  c.points_uri = fs::absolute(a.out).lexically_relative(fs::absolute(a.qif).parent_path()).string();
+  c.points_count = points;
+  c.points_frame = a.frame;
+  c.time_created = QifTimeNow();
+  Check(WriteQifResults(a.qif, run.report.dump(), c));
+}
+
 void RunErrorMap(const ErrorMapArgs& a) {
   auto t0 = std::chrono::steady_clock::now();
   const PointCloud cloud_in_world = Take(ReadPointCloud(a.cloud));
@@ -202,6 +218,7 @@ void RunErrorMap(const ErrorMapArgs& a) {
     Check(WritePdfReport(a.pdf, pdf));
   }
   if (!a.html.empty()) WriteHtml(a, run, cloud_in_part, html_mesh);
+  if (!a.qif.empty()) WriteQif(a, run, written.size());
   if (!a.report.empty()) {
     // The remote report's timing is the server's; the local one is all ours.
     nlohmann::json& timing = run.report["timing"];
@@ -246,6 +263,9 @@ void AddErrorMapCommand(CLI::App& app) {
   cmd->add_option("--part-id", a->part_id, "the part named in the PDF (default: the cloud's stem)");
   cmd->add_option("--html", a->html,
                   "self-contained interactive report (3D view, tables, histogram), part frame");
+  cmd->add_option("--qif", a->qif,
+                  "QIF 3.0 Results: characteristics, verdicts, the PLY as the measured points "
+                  "(docs/integration.md)");
   cmd->add_option("--plan", a->plan,
                   "inspection plan JSON: regions, comparison points, defect detection "
                   "(docs/inspection-plan.md); its default band is +-tolerance");

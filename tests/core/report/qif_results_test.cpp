@@ -1,0 +1,176 @@
+// core/report/qif_results.cpp: the QIF document read back with pugixml
+// against the report it came from, the name-based UUIDs against Python's
+// uuid.uuid5, and (where the QIF 3.0 schemas are beside the checkout) the
+// document validated by xmllint.
+#include "core/report/qif_results.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <pugixml.hpp>
+#include <string>
+
+#include "tests/support/temp_dir.h"
+
+namespace surfinspect {
+namespace {
+
+using nlohmann::json;
+
+json Characteristic(const std::string& name, const std::string& type, const std::string& verdict,
+                    double lower, double upper, int points, double min_mm, double max_mm) {
+  json c = {{"name", name},
+            {"type", type},
+            {"verdict", verdict},
+            {"reason", verdict + ": because"},
+            {"tolerance_mm", {{"lower", lower}, {"upper", upper}}},
+            {"points", points}};
+  c["min_mm"] = points > 0 ? json(min_mm) : json(nullptr);
+  c["max_mm"] = points > 0 ? json(max_mm) : json(nullptr);
+  if (type == "point") c["value_mm"] = points > 0 ? json((min_mm + max_mm) / 2) : json(nullptr);
+  return c;
+}
+
+json Report() {
+  json r = {{"schema", "surfinspect.report/2"}, {"verdict", "fail"}};
+  r["characteristics"] = {
+      Characteristic("surface", "surface", "pass", -0.3, 0.3, 1000, -0.41, 0.12),
+      Characteristic("ridge", "region", "fail", -0.05, 0.15, 200, -0.02, 0.31),
+      Characteristic("P1", "point", "pass", -0.1, 0.1, 12, -0.03, 0.01),
+      Characteristic("P2", "point", "fail", -0.1, 0.1, 0, 0, 0)};
+  return r;
+}
+
+QifContext Context() {
+  QifContext c;
+  c.part_id = "part-0007";
+  c.cell = "cell-a";
+  c.part_model = "part.obj";
+  c.points_count = 1234;
+  c.time_created = "2026-12-01T10:00:00Z";
+  return c;
+}
+
+pugi::xml_node ById(const pugi::xml_document& doc, const std::string& id) {
+  return doc.find_node([&](pugi::xml_node n) { return id == n.attribute("id").value(); });
+}
+
+TEST(QifResults, EveryCharacteristicReadsBackAsTheReportSays) {
+  const json report = Report();
+  auto xml = QifResultsXml(report.dump(), Context());
+  ASSERT_TRUE(xml.ok()) << xml.status();
+  pugi::xml_document doc;
+  ASSERT_TRUE(doc.load_string(xml->c_str()));
+  const pugi::xml_node root = doc.child("QIFDocument");
+  EXPECT_STREQ(root.attribute("versionQIF").value(), "3.0.0");
+  const pugi::xml_node results =
+      root.child("Results").child("MeasurementResultsSet").child("MeasurementResults");
+  EXPECT_STREQ(results.child("InspectionStatus").child_value("InspectionStatusEnum"), "FAIL");
+  EXPECT_STREQ(root.select_node("//ActualComponent/SerialNumber").node().child_value(),
+               "part-0007");
+  EXPECT_STREQ(
+      results.select_node("ExternalFileReferences/ExternalFileReference/URI").node().child_value(),
+      "errormap.ply");
+  const pugi::xml_node list =
+      results.child("MeasuredCharacteristics").child("CharacteristicMeasurements");
+  ASSERT_EQ(list.attribute("n").as_int(), 4);
+  int k = 0;
+  for (pugi::xml_node m : list.children()) {
+    const json& c = report["characteristics"][k];
+    SCOPED_TRACE(c["name"].get<std::string>());
+    const std::string kind = c["type"] == "point" ? "PointProfile" : "SurfaceProfile";
+    EXPECT_EQ(m.name(), kind + "CharacteristicMeasurement");
+    EXPECT_EQ(m.attribute("id").as_int(), 13 + 4 * k);  // stable: from the plan's order
+    EXPECT_EQ(m.child("Status").child_value("CharacteristicStatusEnum"),
+              std::string(c["verdict"] == "pass" ? "PASS" : "FAIL"));
+    // Item -> nominal -> definition: name and tolerance.
+    const pugi::xml_node item = ById(doc, m.child_value("CharacteristicItemId"));
+    EXPECT_EQ(item.child_value("Name"), c["name"].get<std::string>());
+    const pugi::xml_node nominal = ById(doc, item.child_value("CharacteristicNominalId"));
+    const pugi::xml_node def = ById(doc, nominal.child_value("CharacteristicDefinitionId"));
+    const double lower = c["tolerance_mm"]["lower"], upper = c["tolerance_mm"]["upper"];
+    EXPECT_EQ(def.child("ToleranceValue").text().as_double(), upper - lower);
+    EXPECT_EQ(!def.child("OuterDisposition").empty(), lower != -upper);
+    if (lower != -upper) {
+      EXPECT_EQ(def.child("OuterDisposition").text().as_double(), upper);
+    }
+    if (c["points"] == 0) {
+      EXPECT_TRUE(m.child("Value").empty());
+    } else {
+      const double min = c["min_mm"], max = c["max_mm"];
+      const double value = c["type"] == "point" ? c["value_mm"].get<double>()
+                                                : 2 * std::max(std::abs(min), std::abs(max));
+      EXPECT_EQ(m.child("Value").text().as_double(), value);  // exact: shortest round-trip text
+      EXPECT_EQ(m.child("WorstPositiveDeviation").text().as_double(), max);
+      EXPECT_EQ(m.child("WorstNegativeDeviation").text().as_double(), min);
+    }
+    ++k;
+  }
+  EXPECT_EQ(k, 4);
+}
+
+TEST(QifResults, SameInputGivesTheSameBytesAndStableCharacteristicUuids) {
+  auto a = QifResultsXml(Report().dump(), Context());
+  auto b = QifResultsXml(Report().dump(), Context());
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(*a, *b);
+  QifContext other = Context();
+  other.part_id = "part-0008";
+  auto c = QifResultsXml(Report().dump(), other);
+  ASSERT_TRUE(c.ok());
+  pugi::xml_document da, dc;
+  ASSERT_TRUE(da.load_string(a->c_str()) && dc.load_string(c->c_str()));
+  // Another part: another document id, the same characteristic identities.
+  EXPECT_STRNE(da.child("QIFDocument").child_value("QPId"),
+               dc.child("QIFDocument").child_value("QPId"));
+  EXPECT_STREQ(da.select_node("//CharacteristicDesignator/UUID").node().child_value(),
+               dc.select_node("//CharacteristicDesignator/UUID").node().child_value());
+}
+
+TEST(QifResults, UuidIsRfc4122Version5) {
+  // python3: uuid.uuid5(uuid.uuid5(uuid.NAMESPACE_URL, "surfinspect"), NAME)
+  EXPECT_EQ(QifUuid("x"), "3436e54d-bdf5-522e-ac85-876dda827267");
+  EXPECT_EQ(QifUuid("characteristic/part.obj/ridge"), "793b274c-43fb-5ffc-9c60-3cc8ee01a4af");
+}
+
+TEST(QifResults, BadInputIsNamed) {
+  EXPECT_NE(QifResultsXml("not json", Context()).status().message().find("JSON"),
+            std::string::npos);
+  json r = Report();
+  r["schema"] = "surfinspect.report/1";
+  EXPECT_NE(QifResultsXml(r.dump(), Context()).status().message().find("schema"),
+            std::string::npos);
+  r = Report();
+  r["characteristics"][1].erase("tolerance_mm");
+  EXPECT_NE(QifResultsXml(r.dump(), Context()).status().message().find("characteristics[1]"),
+            std::string::npos);
+  QifContext no_part = Context();
+  no_part.part_id.clear();
+  EXPECT_EQ(QifResultsXml(Report().dump(), no_part).status().code(),
+            absl::StatusCode::kInvalidArgument);
+}
+
+TEST(QifResults, ValidatesAgainstTheQif3Schema) {
+  const std::filesystem::path xsd = std::filesystem::path(SURFINSPECT_SOURCE_DIR) /
+                                    "../shared/qif-3.0/QIFApplications/QIFDocument.xsd";
+  if (!std::filesystem::exists(xsd))
+    GTEST_SKIP() << "SKIPPED: no QIF 3.0 schemas at " << xsd << " (see docs/integration.md)";
+  if (std::system("command -v xmllint >/dev/null") != 0) GTEST_SKIP() << "SKIPPED: no xmllint";
+  testing::TempDir dir;
+  json only_surface = Report();
+  only_surface["characteristics"] = {only_surface["characteristics"][0]};
+  only_surface["verdict"] = "pass";
+  for (const json& report : {Report(), only_surface}) {
+    const std::string path = dir.path() + "/r.qif";
+    ASSERT_TRUE(WriteQifResults(path, report.dump(), Context()).ok());
+    const std::string cmd =
+        "xmllint --noout --nonet --schema '" + xsd.string() + "' '" + path + "' 2>&1";
+    EXPECT_EQ(std::system(cmd.c_str()), 0) << report.dump();
+  }
+}
+
+}  // namespace
+}  // namespace surfinspect

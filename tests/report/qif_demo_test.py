@@ -1,0 +1,139 @@
+#!/usr/bin/env python3
+"""Every result.qif of the demo (surfinspect demo-cell, calibrated on a real
+surfinspectd, each part inspected with the cell's plan in-process and one
+through the server, plus `surfinspect errormap --qif`) validates against the
+QIF 3.0 XSD with xmllint, and reads back with each characteristic's value,
+tolerance and status equal to report.json's.
+
+The schemas are not the project's: they are taken from ../shared/qif-3.0
+beside the checkout (SOURCE_DIR/../shared/qif-3.0); without them the schema
+check is SKIPPED, loudly, and the read-back still runs.
+
+usage: qif_demo_test.py BIN_DIR SOURCE_DIR
+"""
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import xml.etree.ElementTree as ET
+
+NS = {"q": "http://qifstandards.org/xsd/qif3"}
+
+
+def check_against_report(qif_path, report):
+    """The QIF's characteristics against the report's, in order."""
+    root = ET.parse(qif_path).getroot()
+    by_id = {e.get("id"): e for e in root.iter() if e.get("id")}
+    status = root.find("q:Results/q:MeasurementResultsSet/q:MeasurementResults/q:InspectionStatus/"
+                       "q:InspectionStatusEnum", NS).text
+    assert status == report["verdict"].upper(), (qif_path, status)
+    measurements = list(root.find(".//q:CharacteristicMeasurements", NS))
+    chars = report["characteristics"]
+    assert len(measurements) == len(chars) >= 1, (qif_path, len(measurements), len(chars))
+    for m, c in zip(measurements, chars):
+        kind = "PointProfile" if c["type"] == "point" else "SurfaceProfile"
+        assert m.tag == "{%s}%sCharacteristicMeasurement" % (NS["q"], kind), (m.tag, c["name"])
+        assert m.find("q:Status/q:CharacteristicStatusEnum", NS).text == c["verdict"].upper(), c["name"]
+        item = by_id[m.find("q:CharacteristicItemId", NS).text]
+        assert item.find("q:Name", NS).text == c["name"]
+        definition = by_id[by_id[item.find("q:CharacteristicNominalId", NS).text]
+                           .find("q:CharacteristicDefinitionId", NS).text]
+        lower, upper = c["tolerance_mm"]["lower"], c["tolerance_mm"]["upper"]
+        assert float(definition.find("q:ToleranceValue", NS).text) == upper - lower, c["name"]
+        value = m.find("q:Value", NS)
+        if not c["points"]:
+            assert value is None, c["name"]
+            continue
+        expected = c["value_mm"] if c["type"] == "point" else 2 * max(abs(c["min_mm"]), abs(c["max_mm"]))
+        assert float(value.text) == expected, (c["name"], value.text, expected)
+        assert float(m.find("q:WorstPositiveDeviation", NS).text) == c["max_mm"], c["name"]
+        assert float(m.find("q:WorstNegativeDeviation", NS).text) == c["min_mm"], c["name"]
+    uri = root.find(".//q:ExternalFileReference/q:URI", NS).text
+    assert os.path.isfile(os.path.join(os.path.dirname(qif_path), uri)), uri
+    return len(chars)
+
+
+def element_paths(root):
+    """Every element's path of tag names (namespace dropped) below the root."""
+    paths = set()
+
+    def walk(e, prefix):
+        path = prefix + "/" + e.tag.split("}")[-1]
+        paths.add(path)
+        for child in e:
+            walk(child, path)
+    walk(root, "")
+    return paths
+
+
+def check_doc_sample(source, qif_path):
+    """docs/integration.md's QIF sample: each of its element paths is in a real file."""
+    with open(os.path.join(source, "docs", "integration.md")) as f:
+        sample = re.search(r"```xml sample=qif\n(.*?)```", f.read(), re.S).group(1)
+    missing = element_paths(ET.fromstring(sample)) - element_paths(ET.parse(qif_path).getroot())
+    assert not missing, f"docs/integration.md's QIF sample has paths no real file has: {sorted(missing)}"
+
+
+def main():
+    if len(sys.argv) != 3:
+        sys.exit(__doc__)
+    bin_dir, source = map(os.path.abspath, sys.argv[1:])
+    xsd = os.path.join(source, "..", "shared", "qif-3.0", "QIFApplications", "QIFDocument.xsd")
+    work = tempfile.mkdtemp(prefix="qif-demo-")
+    si = os.path.join(bin_dir, "surfinspect")
+    server = None
+    try:
+        os.chdir(work)
+        subprocess.run([si, "demo-cell", "--out", "cell", "--parts", "2"], check=True, capture_output=True)
+        server = subprocess.Popen([os.path.join(bin_dir, "surfinspectd"), "--listen", "127.0.0.1:0"],
+                                  stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+        target = server.stdout.readline().split("listening on ")[-1].strip()
+        subprocess.run([os.path.join(bin_dir, "cell-agent"), "calibrate", "--cell", "cell/cell.json",
+                        "--server", target], check=True, capture_output=True)
+        runs = []
+        for part in sorted(os.listdir("cell/scans")):
+            out = f"inspect/{part}"
+            subprocess.run([si, "inspect", "--cell", "cell/cell.json", "--scans", f"cell/scans/{part}",
+                            "--out", out], check=True, capture_output=True)
+            runs.append((f"{out}/result.qif", f"{out}/report.json"))
+        subprocess.run([si, "inspect", "--cell", "cell/cell.json", "--scans", "cell/scans/part-001",
+                        "--out", "remote", "--server", target], check=True, capture_output=True)
+        runs.append(("remote/result.qif", "remote/report.json"))
+        with open("cell/cell.json") as f:
+            json.dump(json.load(f)["part"]["world_from_part"], open("wfp.json", "w"))
+        os.makedirs("em")
+        subprocess.run([si, "errormap", "--cloud", "cell/scans/part-001/v3.pcd", "--mesh", "cell/part.stl",
+                        "--world-from-part", "wfp.json", "--plan", "cell/plan.json", "--out", "em/e.ply",
+                        "--report", "em/e.json", "--qif", "em/e.qif"], check=True, capture_output=True)
+        runs.append(("em/e.qif", "em/e.json"))
+        # Without a plan the whole surface is the one characteristic.
+        subprocess.run([si, "errormap", "--cloud", "cell/scans/part-002/v1.pcd", "--mesh", "cell/part.stl",
+                        "--world-from-part", "wfp.json", "--out", "em/s.ply", "--report", "em/s.json",
+                        "--qif", "em/s.qif"], check=True, capture_output=True)
+        runs.append(("em/s.qif", "em/s.json"))
+        if os.path.exists(xsd):
+            r = subprocess.run(["xmllint", "--noout", "--nonet", "--schema", xsd, *[q for q, _ in runs]],
+                               capture_output=True, text=True)
+            assert r.returncode == 0, r.stderr
+            print(f"QIF 3.0 schema: {len(runs)} files validate ({r.stderr.count('validates')} reported)")
+        else:
+            print("=" * 72 + f"\nSKIPPED the QIF 3.0 schema check: no {os.path.normpath(xsd)}\n"
+                  "(the schemas are not the project's; see docs/integration.md)\n" + "=" * 72)
+        for qif, report in runs:
+            with open(report) as f:
+                n = check_against_report(qif, json.load(f))
+            print(f"{qif}: {n} characteristics equal the report's")
+        check_doc_sample(source, runs[0][0])
+        print("docs/integration.md's QIF sample: every element path occurs in", runs[0][0])
+    finally:
+        if server:
+            server.kill()
+            server.wait()
+        shutil.rmtree(work, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    main()
