@@ -17,6 +17,7 @@
 #include "client/agent/agent.h"
 #include "client/agent/calibrate_cell.h"
 #include "client/agent/simulated_robot.h"
+#include "client/agent/store_recorder.h"
 #include "client/cell/cell_config.h"
 #include "client/remote/remote_client.h"
 #include "core/io/atomic_file.h"
@@ -36,6 +37,8 @@ struct AgentArgs {
   AgentPaths paths;
   std::string server, tls_ca, tls_cert, tls_key, token_file;
   int simulate = 0;
+  std::string drift;  // --drift SPEC for the simulated parts
+  std::string db;     // results store; default RESULTS/results.db, "none" = off
   uint64_t seed = 1;
   bool once = false;
   double poll_s = 1.0, timeout_s = 300;
@@ -155,6 +158,32 @@ InspectFn InspectOver(RemoteClient& client, const TriangleMesh& part,
   };
 }
 
+// The results store's listener, caught up with RESULTS/ (null with --db none).
+std::unique_ptr<StoreRecorder> MakeRecorder(const AgentArgs& a, const CellConfig& cell,
+                                            const InboxLayout& layout, const TriangleMesh& part) {
+  if (a.db == "none") return nullptr;
+  const std::string db = a.db.empty() ? layout.results + "/results.db" : a.db;
+  const char* env = std::getenv("SURFINSPECT_DB");
+  if (RedactDatabaseUrl(db) != db && !(env != nullptr && db == env)) {
+    spdlog::error(
+        "{}: a password on the command line is refused; use PGPASSWORD, PGPASSFILE or "
+        "SURFINSPECT_DB",
+        RedactDatabaseUrl(db));
+    std::exit(2);
+  }
+  std::shared_ptr<const MeshIndex> index = OrDie(MeshIndex::Build(part));
+  auto recorder = std::make_unique<StoreRecorder>(
+      db, RecordContextOf(cell, std::move(index)), layout.results,
+      [](const std::string& message) { spdlog::error("{}", message); });
+  if (auto st = recorder->CatchUp(); !st.ok())
+    spdlog::error("results store: {} (parts are recorded once it can be reached)",
+                  std::string(st.message()));
+  else
+    spdlog::info("results store {}: {} earlier parts recorded from their files",
+                 RedactDatabaseUrl(db), recorder->recorded());
+  return recorder;
+}
+
 int Run(const AgentArgs& a) {
   const CellConfig cell = OrDie(ReadCellConfig(a.cell));
   const InboxLayout layout = ResolveLayout(a.paths);
@@ -165,7 +194,8 @@ int Run(const AgentArgs& a) {
   spdlog::info("inbox {}, results {}, archive {}, quarantine {}", layout.inbox, layout.results,
                layout.archive, layout.quarantine);
   if (a.simulate > 0) {
-    const auto ids = OrDie(SimulateParts(cell, layout.inbox, a.simulate, a.seed));
+    const SurfaceDrift drift = a.drift.empty() ? SurfaceDrift{} : OrDie(ParseSurfaceDrift(a.drift));
+    const auto ids = OrDie(SimulateParts(cell, layout.inbox, a.simulate, a.seed, drift));
     spdlog::info("simulated robot: {} parts dropped into {}", ids.size(), layout.inbox);
   }
   const TriangleMesh part = OrDie(ReadMesh(cell.part_mesh));
@@ -176,6 +206,11 @@ int Run(const AgentArgs& a) {
   hooks.on_retry = [](const std::string& id, const absl::Status& st, int calls, double) {
     spdlog::warn("{}: {} (attempt {}, retrying)", id, std::string(st.message()), calls);
   };
+  std::unique_ptr<StoreRecorder> recorder = MakeRecorder(a, cell, layout, part);
+  if (recorder)
+    hooks.on_stored.push_back([&recorder](const std::string& id, const std::string& dir) {
+      recorder->OnStored(id, dir);
+    });
   AgentSettings settings;
   settings.backoff = a.backoff;
   settings.poll_s = a.poll_s;
@@ -225,6 +260,13 @@ void AddRunOptions(CLI::App* run, AgentArgs& a) {
                   "parts that cannot succeed, with error.txt (default: beside the inbox)");
   run->add_option("--simulate", a.simulate, "first drop N simulated parts into the inbox")
       ->check(CLI::Range(0, 10000));
+  run->add_option("--drift", a.drift,
+                  "with --simulate: a process drift, bow:RATE_MM[:X,Y,R] (grows per part) or "
+                  "shift:AMOUNT_MM@PART[:X,Y,R]; its truth goes into truth.json");
+  run->add_option("--db", a.db,
+                  "results store: SQLite file or postgresql://user@host/db (password from "
+                  "PGPASSWORD/PGPASSFILE); default RESULTS/results.db; none = off")
+      ->envname("SURFINSPECT_DB");
   run->add_flag("--once", a.once, "process what is there, then exit");
   run->add_option("--poll", a.poll_s, "inbox poll interval, s")->check(CLI::PositiveNumber);
 }

@@ -5,11 +5,14 @@
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "client/cell/cell_config.h"
 #include "client/cell/part_outputs.h"
+#include "client/cell/part_recorder.h"
 #include "client/cli/commands.h"
+#include "client/cli/db_args.h"
 #include "client/cli/remote_args.h"
 #include "core/distance/mesh_index.h"
 #include "core/errormap/error_map.h"
@@ -28,6 +31,7 @@ namespace {
 
 struct ErrorMapArgs {
   std::string cloud, mesh, world_from_part, out, csv, report, png, plan;
+  std::string db, part_id, cell_name = "errormap";  // --db: the record's key
   std::string frame = "part";
   std::string png_axis = "auto";
   ErrorMapSettings settings;
@@ -134,7 +138,32 @@ void PrintSummary(const ErrorMapArgs& a, const ErrorMapRun& run) {
               a.png.c_str());
 }
 
+// Records the error map as a part (client/cell/part_recorder.h). The
+// in-process path has each point's triangle; the remote one is matched again
+// on `mesh`.
+void RecordErrorMap(ResultsStore& store, const ErrorMapArgs& a, const PointCloud& cloud_in_world,
+                    const Eigen::Isometry3d& world_from_part, const TriangleMesh& mesh,
+                    const nlohmann::json& plan_json, const ErrorMapRun& run) {
+  client::RecordContext context;
+  context.cell = a.cell_name;
+  context.plan_hash = a.plan.empty() ? "" : client::PlanHash(plan_json);
+  context.world_from_part = world_from_part;
+  context.max_distance_mm = a.settings.max_distance_mm;
+  context.part = Take(MeshIndex::Build(mesh));
+  const std::string part_id =
+      a.part_id.empty() ? std::filesystem::path(a.cloud).stem().string() : a.part_id;
+  PartRecord record =
+      Take(client::MakePartRecord(context, part_id, run.report.dump(), "report", cloud_in_world,
+                                  run.result.deviation_mm, run.result.triangle_id));
+  record.files_json =
+      nlohmann::json{{"cloud", a.cloud}, {"errormap.ply", a.out}, {"report", a.report}}.dump();
+  const bool written = Take(store.Record(record));
+  std::printf("%s %s in %s\n", part_id.c_str(), written ? "recorded" : "was already recorded",
+              store.Name().c_str());
+}
+
 void RunErrorMap(const ErrorMapArgs& a) {
+  const std::unique_ptr<ResultsStore> store = a.db.empty() ? nullptr : OpenStore(a.db, false);
   auto t0 = std::chrono::steady_clock::now();
   const PointCloud cloud_in_world = Take(ReadPointCloud(a.cloud));
   const Eigen::Isometry3d world_from_part = a.world_from_part.empty()
@@ -143,6 +172,7 @@ void RunErrorMap(const ErrorMapArgs& a) {
   const nlohmann::json plan_json =
       a.plan.empty() ? nlohmann::json() : Take(client::ReadPlanJson(a.plan));
   auto mesh = Take(ReadMesh(a.mesh));
+  const TriangleMesh mesh_to_record = store ? mesh : TriangleMesh();
   // A bad plan is refused before anything is measured.
   const InspectionPlan plan = a.plan.empty()
                                   ? PlanFromSettings(a.settings)
@@ -172,6 +202,8 @@ void RunErrorMap(const ErrorMapArgs& a) {
     Check(WriteStringAtomically(a.report, run.report.dump(2) + "\n"));
   }
   PrintSummary(a, run);
+  if (store)
+    RecordErrorMap(*store, a, cloud_in_world, world_from_part, mesh_to_record, plan_json, run);
 }
 
 }  // namespace
@@ -210,6 +242,10 @@ void AddErrorMapCommand(CLI::App& app) {
       ->check(CLI::IsMember({"auto", "x", "y", "z"}))
       ->default_val("auto");
   AddRemoteOptions(cmd, a->remote);
+  AddDbOption(cmd, a->db, "also record the result in this results database");
+  cmd->add_option("--part-id", a->part_id, "with --db: the part's id (default: the cloud's stem)");
+  cmd->add_option("--cell-name", a->cell_name, "with --db: the cell it is recorded under")
+      ->default_val("errormap");
   cmd->callback([a] {
     // Bad parameters are refused before any file is read.
     Check(ValidateErrorMapSettings(a->settings));

@@ -33,5 +33,6 @@ void AddRegisterCommand(CLI::App& app);
 void AddInspectCommand(CLI::App& app);
 void AddHealthCommand(CLI::App& app);
 void AddErrorMapCommand(CLI::App& app);
+void AddTrendCommand(CLI::App& app);
 
 }  // namespace surfinspect::cli

@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   surfinspect::cli::AddInspectCommand(app);
   surfinspect::cli::AddHealthCommand(app);
   surfinspect::cli::AddErrorMapCommand(app);
+  surfinspect::cli::AddTrendCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
