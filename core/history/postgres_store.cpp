@@ -26,10 +26,6 @@ double TextDouble(const pqxx::field& f) {
   return f.is_null() ? NAN : std::strtod(f.c_str(), nullptr);
 }
 
-std::string Key(const std::string& cell, const std::string& part_id) {
-  return cell + '\n' + part_id;
-}
-
 class PostgresStore final : public ResultsStore {
  public:
   PostgresStore(const std::string& url, std::string name)
@@ -164,14 +160,14 @@ void PostgresStore::LoadRows(pqxx::transaction_base& tx, const PartSelection& se
   }
   KeepLast(parts, sel.last);
   std::map<std::string, PartRecord*> by_key;
-  for (PartRecord& p : parts) by_key[Key(p.cell, p.part_id)] = &p;
+  for (PartRecord& p : parts) by_key[StoreKey(p.cell, p.part_id)] = &p;
   for (const auto& row : tx.exec_params(
            "SELECT c.cell, c.part_id, c.name, c.type, c.value_mm, c.mean_mm, c.min_mm, c.max_mm, "
            "c.stddev_mm, c.lower_mm, c.upper_mm, c.verdict, c.points FROM characteristics c "
            "JOIN parts p ON p.cell = c.cell AND p.part_id = c.part_id" +
                Filter(sel) + " ORDER BY c.cell, c.part_id, c.position",
            sel.cell, sel.since_utc)) {
-    auto it = by_key.find(Key(row[0].c_str(), row[1].c_str()));
+    auto it = by_key.find(StoreKey(row[0].c_str(), row[1].c_str()));
     if (it == by_key.end()) continue;
     CharacteristicRecord c;
     c.name = row[2].c_str();
@@ -193,13 +189,13 @@ absl::StatusOr<std::vector<PartRecord>> PostgresStore::Load(const PartSelection&
     LoadRows(tx, sel, parts);
     if (sel.with_triangles) {
       std::map<std::string, PartRecord*> by_key;
-      for (PartRecord& p : parts) by_key[Key(p.cell, p.part_id)] = &p;
+      for (PartRecord& p : parts) by_key[StoreKey(p.cell, p.part_id)] = &p;
       for (const auto& row : tx.exec_params(
                "SELECT t.cell, t.part_id, t.num_triangles, t.packed FROM triangle_summaries t "
                "JOIN parts p ON p.cell = t.cell AND p.part_id = t.part_id" +
                    Filter(sel),
                sel.cell, sel.since_utc)) {
-        auto it = by_key.find(Key(row[0].c_str(), row[1].c_str()));
+        auto it = by_key.find(StoreKey(row[0].c_str(), row[1].c_str()));
         if (it == by_key.end()) continue;
         it->second->num_triangles = row[2].as<uint32_t>();
         const pqxx::binarystring blob(row[3]);

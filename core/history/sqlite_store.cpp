@@ -12,14 +12,9 @@
 namespace surfinspect {
 namespace {
 
-struct DbCloser {
-  void operator()(sqlite3* db) const { sqlite3_close_v2(db); }
-};
-struct StmtCloser {
-  void operator()(sqlite3_stmt* s) const { sqlite3_finalize(s); }
-};
-using Db = std::unique_ptr<sqlite3, DbCloser>;
-using Stmt = std::unique_ptr<sqlite3_stmt, StmtCloser>;
+// RAII for the two C handles.
+using Db = std::unique_ptr<sqlite3, decltype(&sqlite3_close_v2)>;
+using Stmt = std::unique_ptr<sqlite3_stmt, decltype(&sqlite3_finalize)>;
 
 class SqliteStore final : public ResultsStore {
  public:
@@ -41,7 +36,7 @@ class SqliteStore final : public ResultsStore {
     sqlite3_stmt* s = nullptr;
     if (sqlite3_prepare_v2(db_.get(), sql.c_str(), -1, &s, nullptr) != SQLITE_OK)
       return Error("cannot prepare \"" + sql.substr(0, 40) + "\"");
-    return Stmt(s);
+    return Stmt(s, &sqlite3_finalize);
   }
   absl::Status Exec(const std::string& sql) {
     char* err = nullptr;
@@ -67,10 +62,7 @@ void BindText(sqlite3_stmt* s, int i, const std::string& v) {
   sqlite3_bind_text(s, i, v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT);
 }
 void BindDouble(sqlite3_stmt* s, int i, double v) {
-  if (std::isfinite(v))
-    sqlite3_bind_double(s, i, v);
-  else
-    sqlite3_bind_null(s, i);
+  std::isfinite(v) ? sqlite3_bind_double(s, i, v) : sqlite3_bind_null(s, i);  // NaN as NULL
 }
 std::string ColumnText(sqlite3_stmt* s, int i) {
   const unsigned char* t = sqlite3_column_text(s, i);
@@ -82,18 +74,12 @@ double ColumnDouble(sqlite3_stmt* s, int i) {
 
 // The WHERE clause and its parameters for a selection (cell, since).
 std::string PartFilter(const PartSelection& sel, const std::string& table) {
-  std::string where = " WHERE 1=1";
-  if (!sel.cell.empty()) where += " AND " + table + ".cell = :cell";
-  if (!sel.since_utc.empty()) where += " AND p.inspected_utc >= :since";
-  return where;
+  return std::string(" WHERE 1=1") + (sel.cell.empty() ? "" : " AND " + table + ".cell = :cell") +
+         (sel.since_utc.empty() ? "" : " AND p.inspected_utc >= :since");
 }
 void BindFilter(sqlite3_stmt* s, const PartSelection& sel) {
   if (!sel.cell.empty()) BindText(s, sqlite3_bind_parameter_index(s, ":cell"), sel.cell);
   if (!sel.since_utc.empty()) BindText(s, sqlite3_bind_parameter_index(s, ":since"), sel.since_utc);
-}
-
-std::string Key(const std::string& cell, const std::string& part_id) {
-  return cell + '\n' + part_id;
 }
 
 absl::StatusOr<int> SqliteStore::SchemaVersion() {
@@ -214,7 +200,7 @@ absl::StatusOr<bool> SqliteStore::Record(const PartRecord& p) {
 absl::Status SqliteStore::LoadCharacteristics(std::vector<PartRecord>& parts,
                                               const PartSelection& sel) {
   std::map<std::string, PartRecord*> by_key;
-  for (PartRecord& p : parts) by_key[Key(p.cell, p.part_id)] = &p;
+  for (PartRecord& p : parts) by_key[StoreKey(p.cell, p.part_id)] = &p;
   auto s = Prepare(
       "SELECT c.cell, c.part_id, c.name, c.type, c.value_mm, c.mean_mm, c.min_mm, c.max_mm, "
       "c.stddev_mm, c.lower_mm, c.upper_mm, c.verdict, c.points FROM characteristics c "
@@ -225,7 +211,7 @@ absl::Status SqliteStore::LoadCharacteristics(std::vector<PartRecord>& parts,
   int rc;
   while ((rc = sqlite3_step(s->get())) == SQLITE_ROW) {
     sqlite3_stmt* r = s->get();
-    auto it = by_key.find(Key(ColumnText(r, 0), ColumnText(r, 1)));
+    auto it = by_key.find(StoreKey(ColumnText(r, 0), ColumnText(r, 1)));
     if (it == by_key.end()) continue;
     CharacteristicRecord c;
     c.name = ColumnText(r, 2);
@@ -242,7 +228,7 @@ absl::Status SqliteStore::LoadCharacteristics(std::vector<PartRecord>& parts,
 
 absl::Status SqliteStore::LoadTriangles(std::vector<PartRecord>& parts, const PartSelection& sel) {
   std::map<std::string, PartRecord*> by_key;
-  for (PartRecord& p : parts) by_key[Key(p.cell, p.part_id)] = &p;
+  for (PartRecord& p : parts) by_key[StoreKey(p.cell, p.part_id)] = &p;
   auto s = Prepare(
       "SELECT t.cell, t.part_id, t.num_triangles, t.packed FROM triangle_summaries t "
       "JOIN parts p ON p.cell = t.cell AND p.part_id = t.part_id" +
@@ -252,7 +238,7 @@ absl::Status SqliteStore::LoadTriangles(std::vector<PartRecord>& parts, const Pa
   int rc;
   while ((rc = sqlite3_step(s->get())) == SQLITE_ROW) {
     sqlite3_stmt* r = s->get();
-    auto it = by_key.find(Key(ColumnText(r, 0), ColumnText(r, 1)));
+    auto it = by_key.find(StoreKey(ColumnText(r, 0), ColumnText(r, 1)));
     if (it == by_key.end()) continue;
     it->second->num_triangles = static_cast<uint32_t>(sqlite3_column_int64(r, 2));
     const char* blob = static_cast<const char*>(sqlite3_column_blob(r, 3));
@@ -299,7 +285,7 @@ absl::StatusOr<std::unique_ptr<ResultsStore>> OpenSqliteStore(const std::string&
   sqlite3* raw = nullptr;
   const int rc =
       sqlite3_open_v2(path.c_str(), &raw, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
-  Db db(raw);
+  Db db(raw, &sqlite3_close_v2);
   if (rc != SQLITE_OK)
     return absl::NotFoundError(absl::StrCat(path, ": cannot open the results database: ",
                                             raw ? sqlite3_errmsg(raw) : sqlite3_errstr(rc)));

@@ -33,6 +33,11 @@ absl::Status CheckSchemaVersion(const std::string& database, int found);
 std::string PackTriangles(const std::vector<TriangleStat>& triangles);
 absl::StatusOr<std::vector<TriangleStat>> UnpackTriangles(const std::string& bytes);
 
+// The idempotency key (cell, part id) as one map key.
+inline std::string StoreKey(const std::string& cell, const std::string& part_id) {
+  return cell + '\n' + part_id;
+}
+
 // Applies PartSelection::last to parts already in order (keeps the newest).
 template <typename T>
 void KeepLast(std::vector<T>& parts, int last) {
