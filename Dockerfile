@@ -22,6 +22,7 @@ RUN apt-get update \
       libabsl20220623 libassimp5 libembree3-3 libfmt9 libgrpc++1.51 libgrpc29 \
       libpcl-common1.13 libpcl-io1.13 libpng16-16 libprometheus-cpp-core1.0 \
       libprometheus-cpp-pull1.0 libprotobuf32 libspdlog1.10 libssl3 libstdc++6 libtbb12 \
+      libsqlite3-0 libpqxx-6.4 libpq5 \
  && rm -rf /var/lib/apt/lists/*
 RUN useradd --system --uid 10001 --user-group --home-dir /var/lib/surfinspect --create-home \
       --shell /usr/sbin/nologin surfinspect

@@ -12,6 +12,7 @@
 // 123456Z"), so their text order is their time order.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <string>

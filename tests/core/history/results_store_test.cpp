@@ -203,7 +203,17 @@ void KillMidWrite(const std::string& url) {
       if (!(*store)->Record(MakePart("killed", k, kTriangles)).ok()) return 11;
     return 0;
   });
-  std::this_thread::sleep_for(std::chrono::milliseconds(700));
+  // Kill as soon as the second part is in: the writer is then in the middle
+  // of the third (each write takes tens of ms; the poll is every 5 ms).
+  {
+    auto watcher = Open(url);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (std::chrono::steady_clock::now() < deadline) {
+      auto there = watcher->Contains("killed", "part-0001");
+      if (there.ok() && *there) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+  }
   ::kill(pid, SIGKILL);
   EXPECT_EQ(Wait(pid), 128 + SIGKILL);
   auto store = Open(url);
