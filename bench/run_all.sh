@@ -21,7 +21,8 @@ log "peer comparison table -> $RESULTS_DIR/latest.md"
 # The per-kernel Google Benchmarks, short: the table above is the record.
 # The service rows (ErrorMap over loopback, streaming) live in peers_bench.
 if [ "${BENCH_SKIP_GBENCH:-0}" != 1 ]; then
-  for b in link_clustering_bench scan_simulator_bench report_bench html_report_bench verify_bench; do
+  for b in link_clustering_bench scan_simulator_bench report_bench html_report_bench verify_bench \
+           results_store_bench; do
     [ -x "$BIN_DIR/$b" ] || die "$BIN_DIR/$b not built"
     log "$b"
     tmp=$(mktemp "$RESULTS_DIR/.gbench-$b.XXXXXX")

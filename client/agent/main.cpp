@@ -19,6 +19,7 @@
 #include "client/agent/calibrate_cell.h"
 #include "client/agent/mqtt_publisher.h"
 #include "client/agent/simulated_robot.h"
+#include "client/agent/store_recorder.h"
 #include "client/agent/verify_cell.h"
 #include "client/cell/cell_config.h"
 #include "client/remote/remote_client.h"
@@ -40,6 +41,8 @@ struct AgentArgs {
   AgentPaths paths;
   std::string server, tls_ca, tls_cert, tls_key, token_file;
   int simulate = 0;
+  std::string drift;  // --drift SPEC for the simulated parts
+  std::string db;     // results store; default RESULTS/results.db, "none" = off
   uint64_t seed = 1;
   bool once = false;
   double poll_s = 1.0, timeout_s = 300;
@@ -241,6 +244,50 @@ std::unique_ptr<MqttPublisher> StartMqtt(const AgentArgs& a, const CellConfig& c
   return OrDie(MqttPublisher::Start(s, cell.name, layout.results, std::move(log)));
 }
 
+// The results store's listener, caught up with RESULTS/ (null with --db none).
+std::unique_ptr<StoreRecorder> MakeRecorder(const AgentArgs& a, const CellConfig& cell,
+                                            const InboxLayout& layout, const TriangleMesh& part) {
+  if (a.db == "none") return nullptr;
+  const std::string db = a.db.empty() ? layout.results + "/results.db" : a.db;
+  const char* env = std::getenv("SURFINSPECT_DB");
+  if (RedactDatabaseUrl(db) != db && !(env != nullptr && db == env)) {
+    spdlog::error(
+        "{}: a password on the command line is refused; use PGPASSWORD, PGPASSFILE or "
+        "SURFINSPECT_DB",
+        RedactDatabaseUrl(db));
+    std::exit(2);
+  }
+  std::shared_ptr<const MeshIndex> index = OrDie(MeshIndex::Build(part));
+  auto recorder = std::make_unique<StoreRecorder>(
+      db, RecordContextOf(cell, std::move(index)), layout.results,
+      [](const std::string& message) { spdlog::error("{}", message); });
+  if (auto st = recorder->CatchUp(); !st.ok())
+    spdlog::error("results store: {} (parts are recorded once it can be reached)",
+                  std::string(st.message()));
+  else
+    spdlog::info("results store {}: {} earlier parts recorded from their files",
+                 RedactDatabaseUrl(db), recorder->recorded());
+  return recorder;
+}
+
+// The run's last lines, and the exit code: 0, or 2 (configuration), 3 (parts
+// quarantined), 4 (stopped by a failed drift check).
+int PrintSummary(const AgentArgs& a, const InboxLayout& layout, const RunSummary& s) {
+  if (s.config_error) return 2;
+  if (!s.halted.empty()) {
+    spdlog::error(
+        "stopped inspecting: {}; {} parts left in {} (state in {}/calibration_status.json)",
+        s.halted, CompleteParts(layout.inbox).size(), layout.inbox, StatusDir(a));
+    return 4;
+  }
+  std::printf("summary: %d parts done (%d pass, %d fail), ", s.done, s.pass, s.done - s.pass);
+  if (s.archived_without_call > 0)
+    std::printf("%d archived with earlier results, ", s.archived_without_call);
+  std::printf("%d quarantined, %zu left in %s\n", s.quarantined, CompleteParts(layout.inbox).size(),
+              layout.inbox.c_str());
+  return s.quarantined == 0 ? 0 : 3;
+}
+
 int Run(const AgentArgs& a) {
   const CellConfig cell = OrDie(ReadCellConfig(a.cell));
   const InboxLayout layout = ResolveLayout(a.paths);
@@ -253,7 +300,9 @@ int Run(const AgentArgs& a) {
   const RobotDrift drift =
       a.robot_drift.empty() ? RobotDrift{} : OrDie(ParseRobotDrift(a.robot_drift));
   if (a.simulate > 0) {
-    const auto ids = OrDie(SimulateParts(cell, layout.inbox, a.simulate, a.seed, drift));
+    const SurfaceDrift surface =
+        a.drift.empty() ? SurfaceDrift{} : OrDie(ParseSurfaceDrift(a.drift));
+    const auto ids = OrDie(SimulateParts(cell, layout.inbox, a.simulate, a.seed, surface, drift));
     spdlog::info("simulated robot: {} parts dropped into {}", ids.size(), layout.inbox);
   }
   const TriangleMesh part = OrDie(ReadMesh(cell.part_mesh));
@@ -285,6 +334,11 @@ int Run(const AgentArgs& a) {
         });
     hooks.before_part = [&monitor](int done) { return monitor->BeforePart(done); };
   }
+  std::unique_ptr<StoreRecorder> recorder = MakeRecorder(a, cell, layout, part);
+  if (recorder)
+    hooks.on_stored.push_back([&recorder](const std::string& id, const std::string& dir) {
+      recorder->OnStored(id, dir);
+    });
   AgentSettings settings;
   settings.backoff = a.backoff;
   settings.poll_s = a.poll_s;
@@ -298,19 +352,7 @@ int Run(const AgentArgs& a) {
   // A failed drift check makes the calibration unusable, as a missing one does.
   if (mqtt && !s.halted.empty()) mqtt->CalibrationExpired(s.halted);
   if (mqtt) mqtt->Stop();
-  if (s.config_error) return 2;
-  if (!s.halted.empty()) {
-    spdlog::error(
-        "stopped inspecting: {}; {} parts left in {} (state in {}/calibration_status.json)",
-        s.halted, CompleteParts(layout.inbox).size(), layout.inbox, StatusDir(a));
-    return 4;
-  }
-  std::printf("summary: %d parts done (%d pass, %d fail), ", s.done, s.pass, s.done - s.pass);
-  if (s.archived_without_call > 0)
-    std::printf("%d archived with earlier results, ", s.archived_without_call);
-  std::printf("%d quarantined, %zu left in %s\n", s.quarantined, CompleteParts(layout.inbox).size(),
-              layout.inbox.c_str());
-  return s.quarantined == 0 ? 0 : 3;
+  return PrintSummary(a, layout, s);
 }
 
 void AddConnection(CLI::App* cmd, AgentArgs& a) {
@@ -346,6 +388,13 @@ void AddRunOptions(CLI::App* run, AgentArgs& a) {
                   "parts that cannot succeed, with error.txt (default: beside the inbox)");
   run->add_option("--simulate", a.simulate, "first drop N simulated parts into the inbox")
       ->check(CLI::Range(0, 10000));
+  run->add_option("--drift", a.drift,
+                  "with --simulate: a process drift, bow:RATE_MM[:X,Y,R] (grows per part) or "
+                  "shift:AMOUNT_MM@PART[:X,Y,R]; its truth goes into truth.json");
+  run->add_option("--db", a.db,
+                  "results store: SQLite file or postgresql://user@host/db (password from "
+                  "PGPASSWORD/PGPASSFILE); default RESULTS/results.db; none = off")
+      ->envname("SURFINSPECT_DB");
   run->add_flag("--once", a.once, "process what is there, then exit");
   run->add_option("--poll", a.poll_s, "inbox poll interval, s")->check(CLI::PositiveNumber);
   run->add_option("--verify-every", a.verify_every,

@@ -6,7 +6,10 @@
 #include <functional>
 #include <random>
 
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_split.h"
 #include "core/io/atomic_file.h"
 #include "core/io/io_mesh.h"
 #include "core/io/io_point_cloud.h"
@@ -28,6 +31,22 @@ SensorIntrinsics IntrinsicsOf(const CellConfig& cell) {
     intrinsics.max_range_mm = s.value("max_range_mm", intrinsics.max_range_mm);
   }
   return intrinsics;
+}
+
+// The scanner's imperfections: noise 0.015 mm, 0.3% pulses, stripes at
+// depth jumps, unless cell.json's optional "simulation" block says otherwise.
+ScanOptions ScanOptionsOf(const CellConfig& cell) {
+  ScanOptions opt;
+  opt.noise_sigma_mm = 0.015;
+  opt.pulse_fraction = 0.003;
+  opt.stripes = true;
+  if (cell.raw.contains("simulation") && cell.raw["simulation"].is_object()) {
+    const auto& s = cell.raw["simulation"];
+    opt.noise_sigma_mm = s.value("noise_sigma_mm", opt.noise_sigma_mm);
+    opt.pulse_fraction = s.value("pulse_fraction", opt.pulse_fraction);
+    opt.stripes = s.value("stripes", opt.stripes);
+  }
+  return opt;
 }
 
 // Height of the highest facet above (x, y), by a vertical probe of the mesh;
@@ -72,16 +91,22 @@ Eigen::Isometry3d DriftedPose(const CellConfig& cell, const CellViewpoint& vp,
   return pose;
 }
 
-ScanOptions RobotScanOptions() {
-  ScanOptions opt;
-  opt.noise_sigma_mm = 0.015;
-  opt.pulse_fraction = 0.003;
-  opt.stripes = true;
-  return opt;
+// Where a drift's bump sits, part frame (x, y).
+Eigen::Vector2d DriftCenterXY(const TriangleMesh& part, const SurfaceDrift& drift) {
+  const Bounds3 b = ComputeBounds(part);
+  return drift.center_xy.value_or(Eigen::Vector2d(0.5 * (b.min.x() + b.max.x()), 0.0));
 }
 
+// An area the random defects stay out of (the drift's bump, so that the
+// drift is measured as itself); radius 0 = none.
+struct KeepClear {
+  Eigen::Vector2d xy = Eigen::Vector2d::Zero();
+  double radius_mm = 0;
+};
+
 // Two defects on the ridge's top (a bump, then a dent); their truth as JSON.
-nlohmann::json PlantDefects(const TriangleMesh& part, std::mt19937_64& rng, ScanOptions* opt) {
+nlohmann::json PlantDefects(const TriangleMesh& part, std::mt19937_64& rng, ScanOptions* opt,
+                            const KeepClear& clear = {}) {
   const Bounds3 b = ComputeBounds(part);
   std::uniform_real_distribution<double> ux(b.min.x() + 0.1 * (b.max.x() - b.min.x()),
                                             b.max.x() - 0.1 * (b.max.x() - b.min.x()));
@@ -89,8 +114,12 @@ nlohmann::json PlantDefects(const TriangleMesh& part, std::mt19937_64& rng, Scan
   nlohmann::json defects = nlohmann::json::array();
   for (int d = 0; d < 2; ++d) {
     SurfaceDefect defect;
-    const double x = ux(rng), y = uy(rng);
+    double x = ux(rng), y = uy(rng);
     defect.radius_mm = uradius(rng);
+    for (int tries = 0; tries < 100 && (Eigen::Vector2d(x, y) - clear.xy).norm() <
+                                           clear.radius_mm + 2 * defect.radius_mm;
+         ++tries)
+      x = ux(rng), y = uy(rng);
     defect.depth_mm = (d == 1 ? -1 : 1) * udepth(rng);
     const double top = HighestFacetZ(part, x, y, b.max.z());
     defect.center_in_part = {x, y, top};
@@ -102,9 +131,28 @@ nlohmann::json PlantDefects(const TriangleMesh& part, std::mt19937_64& rng, Scan
   return defects;
 }
 
+// The drift's bump on part k, added to the scan; its truth as JSON.
+nlohmann::json PlantDrift(const TriangleMesh& part, const SurfaceDrift& drift, int k,
+                          ScanOptions* opt) {
+  const Bounds3 b = ComputeBounds(part);
+  const Eigen::Vector2d xy = DriftCenterXY(part, drift);
+  SurfaceDefect bump;
+  bump.center_in_part = {xy.x(), xy.y(), HighestFacetZ(part, xy.x(), xy.y(), b.max.z())};
+  bump.radius_mm = drift.radius_mm;
+  bump.depth_mm = -drift.HeightAt(k);  // a depth < 0 is a bump
+  if (bump.depth_mm != 0) opt->defects.push_back(bump);
+  const Eigen::Vector3d& c = bump.center_in_part;
+  return {{"spec", drift.spec},
+          {"kind", drift.kind == SurfaceDrift::Kind::kBow ? "bow" : "shift"},
+          {"part_index", k},
+          {"center_in_part", {c.x(), c.y(), c.z()}},
+          {"radius_mm", bump.radius_mm},
+          {"height_mm", drift.HeightAt(k)}};
+}
+
 // Scans one part at every viewpoint into DIR, then truth.json, then DONE.
 absl::Status DropPart(const CellConfig& cell, const TriangleMesh& part, const fs::path& dir,
-                      ScanOptions opt, const nlohmann::json& defects, uint64_t seed, int n,
+                      ScanOptions opt, const nlohmann::json& truth, uint64_t seed, int n,
                       const RobotDrift& drift) {
   std::error_code ec;
   fs::create_directories(dir, ec);
@@ -120,11 +168,23 @@ absl::Status DropPart(const CellConfig& cell, const TriangleMesh& part, const fs
         !st.ok())
       return st;
   }
-  if (auto st = WriteStringAtomically((dir / "truth.json").string(),
-                                      nlohmann::json{{"defects", defects}}.dump(2) + "\n");
+  if (auto st = WriteStringAtomically((dir / "truth.json").string(), truth.dump(2) + "\n");
       !st.ok())
     return st;
   return WriteStringAtomically((dir / "DONE").string(), "");
+}
+
+// "X,Y,R" after a spec's second colon.
+absl::Status ParsePlace(const std::string& spec, const std::string& text, SurfaceDrift* d) {
+  std::vector<std::string> xyr = absl::StrSplit(text, ',');
+  double x = 0, y = 0, r = 0;
+  if (xyr.size() != 3 || !absl::SimpleAtod(xyr[0], &x) || !absl::SimpleAtod(xyr[1], &y) ||
+      !absl::SimpleAtod(xyr[2], &r) || !(r > 0))
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--drift ", spec, ": the place must be X,Y,R in mm with R > 0, got '", text, "'"));
+  d->center_xy = Eigen::Vector2d(x, y);
+  d->radius_mm = r;
+  return absl::OkStatus();
 }
 
 }  // namespace
@@ -144,7 +204,7 @@ absl::StatusOr<RobotDrift> ParseRobotDrift(const std::string& text) {
 absl::StatusOr<PointCloud> SimulateGaugeScan(const CellConfig& cell, const TriangleMesh& gauge,
                                              const CellViewpoint& vp, const RobotDrift& drift,
                                              uint64_t seed) {
-  ScanOptions opt = RobotScanOptions();
+  ScanOptions opt = ScanOptionsOf(cell);
   opt.seed = seed * 1000003 + std::hash<std::string>{}(vp.name) % 1000;
   auto scan = SimulateScan(gauge, vp.world_from_gauge, DriftedPose(cell, vp, drift),
                            IntrinsicsOf(cell), opt);
@@ -152,15 +212,50 @@ absl::StatusOr<PointCloud> SimulateGaugeScan(const CellConfig& cell, const Trian
   return std::move(scan->cloud_in_sensor);
 }
 
-absl::StatusOr<std::vector<std::string>> SimulateParts(const CellConfig& cell,
-                                                       const std::string& inbox, int count,
-                                                       uint64_t seed) {
-  return SimulateParts(cell, inbox, count, seed, RobotDrift{});
+double SurfaceDrift::HeightAt(int k) const {
+  switch (kind) {
+    case Kind::kBow:
+      return amount_mm * k;
+    case Kind::kShift:
+      return k + 1 >= from_part ? amount_mm : 0.0;
+    case Kind::kNone:
+      break;
+  }
+  return 0.0;
+}
+
+absl::StatusOr<SurfaceDrift> ParseSurfaceDrift(const std::string& spec) {
+  SurfaceDrift d;
+  d.spec = spec;
+  std::vector<std::string> parts = absl::StrSplit(spec, absl::MaxSplits(':', 2));
+  const auto bad = [&](const std::string& why) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--drift ", spec, ": ", why,
+                     " (expected bow:RATE_MM[:X,Y,R] or shift:AMOUNT_MM@PART[:X,Y,R])"));
+  };
+  if (parts.size() < 2) return bad("no amount");
+  std::vector<std::string> amount = absl::StrSplit(parts[1], '@');
+  if (!absl::SimpleAtod(amount[0], &d.amount_mm) || !std::isfinite(d.amount_mm))
+    return bad("the amount is not a number");
+  if (parts[0] == "bow") {
+    d.kind = SurfaceDrift::Kind::kBow;
+    if (amount.size() != 1) return bad("a bow has no @PART");
+  } else if (parts[0] == "shift") {
+    d.kind = SurfaceDrift::Kind::kShift;
+    if (amount.size() != 2 || !absl::SimpleAtoi(amount[1], &d.from_part) || d.from_part < 1)
+      return bad("a shift needs @PART, the first part (1-based) with the step");
+  } else {
+    return bad("unknown kind '" + parts[0] + "'");
+  }
+  if (parts.size() == 3)
+    if (auto st = ParsePlace(spec, parts[2], &d); !st.ok()) return st;
+  return d;
 }
 
 absl::StatusOr<std::vector<std::string>> SimulateParts(const CellConfig& cell,
                                                        const std::string& inbox, int count,
-                                                       uint64_t seed, const RobotDrift& drift) {
+                                                       uint64_t seed, const SurfaceDrift& drift,
+                                                       const RobotDrift& robot) {
   auto part = ReadMesh(cell.part_mesh);
   if (!part.ok()) return part.status();
   std::mt19937_64 rng(seed);
@@ -169,10 +264,14 @@ absl::StatusOr<std::vector<std::string>> SimulateParts(const CellConfig& cell,
     const std::string id = absl::StrFormat("sim-%04d-%04d", seed % 10000, n);
     if (fs::exists(fs::path(inbox) / id)) continue;
     ++k;
-    ScanOptions opt = RobotScanOptions();
-    const nlohmann::json defects = PlantDefects(*part, rng, &opt);
-    if (auto st = DropPart(cell, *part, fs::path(inbox) / id, opt, defects, seed, n, drift);
-        !st.ok())
+    ScanOptions opt = ScanOptionsOf(cell);
+    KeepClear clear;
+    if (drift.kind != SurfaceDrift::Kind::kNone)
+      clear = {DriftCenterXY(*part, drift), drift.radius_mm};
+    nlohmann::json truth = {{"defects", PlantDefects(*part, rng, &opt, clear)}};
+    if (drift.kind != SurfaceDrift::Kind::kNone)
+      truth["drift"] = PlantDrift(*part, drift, k - 1, &opt);
+    if (auto st = DropPart(cell, *part, fs::path(inbox) / id, opt, truth, seed, n, robot); !st.ok())
       return st;
     ids.push_back(id);
   }

@@ -1,10 +1,16 @@
 // The simulated robot for demos and tests: scans new parts with the virtual
 // area sensor at the cell's viewpoints, plants random dents and bumps on the
 // ridge, and drops them into the inbox exactly as a scanner would (scans
-// first, each written atomically, then the DONE marker). The planted defects
-// go into <part>/truth.json beside the scans.
+// first, each written atomically, then the DONE marker). cell.json's
+// optional "simulation" block sets the scanner's noise_sigma_mm (0.015),
+// pulse_fraction (0.003) and stripes (true). The planted defects
+// go into <part>/truth.json beside the scans, and so does the process drift
+// when one is asked for (a bump that grows from part to part, or that
+// appears at part k), so that trend tests know the truth.
 #pragma once
 
+#include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,14 +37,35 @@ absl::StatusOr<PointCloud> SimulateGaugeScan(const CellConfig& cell, const Trian
                                              const CellViewpoint& vp, const RobotDrift& drift,
                                              uint64_t seed);
 
-// As below, scanned by a robot that has drifted.
-absl::StatusOr<std::vector<std::string>> SimulateParts(const CellConfig& cell,
-                                                       const std::string& inbox, int count,
-                                                       uint64_t seed, const RobotDrift& drift);
+// A systematic change of the surface across the parts of one run, as a
+// Gaussian bump (scan_simulator.h SurfaceDefect, + above the CAD) whose
+// height depends on the part's index k = 0, 1, ... in the run:
+//   "bow:RATE[:X,Y,R]"       height RATE * k mm (a bow that grows per part)
+//   "shift:AMOUNT@K[:X,Y,R]" height AMOUNT mm from the K-th part (1-based) on
+// centred on the part's surface at (X, Y) in the part frame (default: the
+// middle of the part's x extent, y = 0: the demo part's ridge) with radius R
+// mm (default 40; the bump is exp(-2) of its height at R). The random
+// defects of a drifting run stay clear of the bump, so that the drift is
+// measured as itself.
+struct SurfaceDrift {
+  enum class Kind { kNone, kBow, kShift } kind = Kind::kNone;
+  double amount_mm = 0;                      // bow: per part; shift: the step
+  int from_part = 1;                         // shift: the first part (1-based) with the step
+  std::optional<Eigen::Vector2d> center_xy;  // part frame, mm; unset = the default
+  double radius_mm = 40;
+  std::string spec;  // as given
+  // The bump's height on the part with index k (0-based), mm.
+  double HeightAt(int k) const;
+};
+// InvalidArgument naming the spec and what is wrong with it.
+absl::StatusOr<SurfaceDrift> ParseSurfaceDrift(const std::string& spec);
 
-// Returns the new part ids.
+// Returns the new part ids. `drift` changes the parts' surface, `robot`
+// the pose the sensor really scans from.
 absl::StatusOr<std::vector<std::string>> SimulateParts(const CellConfig& cell,
                                                        const std::string& inbox, int count,
-                                                       uint64_t seed);
+                                                       uint64_t seed,
+                                                       const SurfaceDrift& drift = {},
+                                                       const RobotDrift& robot = {});
 
 }  // namespace surfinspect::client

@@ -10,7 +10,9 @@
 
 #include "client/cell/cell_config.h"
 #include "client/cell/part_outputs.h"
+#include "client/cell/part_recorder.h"
 #include "client/cli/commands.h"
+#include "client/cli/db_args.h"
 #include "client/cli/remote_args.h"
 #include "core/distance/mesh_index.h"
 #include "core/errormap/error_map.h"
@@ -31,12 +33,18 @@ namespace surfinspect::cli {
 namespace {
 
 struct ErrorMapArgs {
-  std::string cloud, mesh, world_from_part, out, csv, report, png, pdf, plan, part_id, html, qif;
+  std::string cloud, mesh, world_from_part, out, csv, report, png, pdf, plan, html, qif;
+  std::string db, part_id, cell_name = "errormap";  // the part in the PDF and the --db record
   std::string frame = "part";
   std::string png_axis = "auto";
   ErrorMapSettings settings;
   RemoteArgs remote;
 };
+
+// The part the reports and the record name: --part-id, or the cloud file's stem.
+std::string PartIdOf(const ErrorMapArgs& a) {
+  return a.part_id.empty() ? std::filesystem::path(a.cloud).stem().string() : a.part_id;
+}
 
 double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
@@ -157,7 +165,7 @@ void WriteHtml(const ErrorMapArgs& a, const ErrorMapRun& run, const PointCloud& 
   in.points_in_part = &cloud_in_part;
   in.deviation_mm = &run.result.deviation_mm;
   in.mesh_in_part = &mesh;
-  in.context.part_id = std::filesystem::path(a.cloud).stem().string();
+  in.context.part_id = PartIdOf(a);
   Check(WriteHtmlReport(a.html, in));
 }
 
@@ -166,7 +174,7 @@ void WriteHtml(const ErrorMapArgs& a, const ErrorMapRun& run, const PointCloud& 
 void WriteQif(const ErrorMapArgs& a, const ErrorMapRun& run, std::size_t points) {
   namespace fs = std::filesystem;
   QifContext c;
-  c.part_id = fs::path(a.cloud).stem().string();
+  c.part_id = PartIdOf(a);
   c.cell = "surfinspect errormap";
   c.part_model = fs::path(a.mesh).filename().string();
   c.points_uri = fs::absolute(a.out).lexically_relative(fs::absolute(a.qif).parent_path()).string();
@@ -176,7 +184,31 @@ void WriteQif(const ErrorMapArgs& a, const ErrorMapRun& run, std::size_t points)
   Check(WriteQifResults(a.qif, run.report.dump(), c));
 }
 
+// Records the error map as a part (client/cell/part_recorder.h). The
+// in-process path has each point's triangle; the remote one is matched again
+// on `mesh`.
+void RecordErrorMap(ResultsStore& store, const ErrorMapArgs& a, const PointCloud& cloud_in_world,
+                    const Eigen::Isometry3d& world_from_part, const TriangleMesh& mesh,
+                    const nlohmann::json& plan_json, const ErrorMapRun& run) {
+  client::RecordContext context;
+  context.cell = a.cell_name;
+  context.plan_hash = a.plan.empty() ? "" : client::PlanHash(plan_json);
+  context.world_from_part = world_from_part;
+  context.max_distance_mm = a.settings.max_distance_mm;
+  context.part = Take(MeshIndex::Build(mesh));
+  const std::string part_id = PartIdOf(a);
+  PartRecord record =
+      Take(client::MakePartRecord(context, part_id, run.report.dump(), "report", cloud_in_world,
+                                  run.result.deviation_mm, run.result.triangle_id));
+  record.files_json =
+      nlohmann::json{{"cloud", a.cloud}, {"errormap.ply", a.out}, {"report", a.report}}.dump();
+  const bool written = Take(store.Record(record));
+  std::printf("%s %s in %s\n", part_id.c_str(), written ? "recorded" : "was already recorded",
+              store.Name().c_str());
+}
+
 void RunErrorMap(const ErrorMapArgs& a) {
+  const std::unique_ptr<ResultsStore> store = a.db.empty() ? nullptr : OpenStore(a.db, false);
   auto t0 = std::chrono::steady_clock::now();
   const PointCloud cloud_in_world = Take(ReadPointCloud(a.cloud));
   const Eigen::Isometry3d world_from_part = a.world_from_part.empty()
@@ -185,6 +217,7 @@ void RunErrorMap(const ErrorMapArgs& a) {
   const nlohmann::json plan_json =
       a.plan.empty() ? nlohmann::json() : Take(client::ReadPlanJson(a.plan));
   auto mesh = Take(ReadMesh(a.mesh));
+  const TriangleMesh mesh_to_record = store ? mesh : TriangleMesh();
   // A bad plan is refused before anything is measured.
   const InspectionPlan plan = a.plan.empty()
                                   ? PlanFromSettings(a.settings)
@@ -211,7 +244,7 @@ void RunErrorMap(const ErrorMapArgs& a) {
   if (!a.png.empty()) Check(WriteStringAtomically(a.png, run.png_bytes));
   if (!a.pdf.empty()) {
     PdfReportInput pdf;
-    pdf.part_id = a.part_id.empty() ? std::filesystem::path(a.cloud).stem().string() : a.part_id;
+    pdf.part_id = PartIdOf(a);
     pdf.report = &run.report;
     pdf.points_in_part = &cloud_in_part;
     pdf.deviation_mm = &run.result.deviation_mm;
@@ -237,6 +270,8 @@ void RunErrorMap(const ErrorMapArgs& a) {
     Check(WriteStringAtomically(a.report, run.report.dump(2) + "\n"));
   }
   PrintSummary(a, run);
+  if (store)
+    RecordErrorMap(*store, a, cloud_in_world, world_from_part, mesh_to_record, plan_json, run);
 }
 
 }  // namespace
@@ -260,7 +295,6 @@ void AddErrorMapCommand(CLI::App& app) {
   cmd->add_option("--pdf", a->pdf,
                   "PDF report (A4): header, verdict, map views, colour bar, histogram, "
                   "characteristics and defects");
-  cmd->add_option("--part-id", a->part_id, "the part named in the PDF (default: the cloud's stem)");
   cmd->add_option("--html", a->html,
                   "self-contained interactive report (3D view, tables, histogram), part frame");
   cmd->add_option("--qif", a->qif,
@@ -286,6 +320,11 @@ void AddErrorMapCommand(CLI::App& app) {
       ->check(CLI::IsMember({"auto", "x", "y", "z"}))
       ->default_val("auto");
   AddRemoteOptions(cmd, a->remote);
+  AddDbOption(cmd, a->db, "also record the result in this results database");
+  cmd->add_option("--part-id", a->part_id,
+                  "the part's id in the PDF and the --db record (default: the cloud's stem)");
+  cmd->add_option("--cell-name", a->cell_name, "with --db: the cell it is recorded under")
+      ->default_val("errormap");
   cmd->callback([a] {
     // Bad parameters are refused before any file is read.
     Check(ValidateErrorMapSettings(a->settings));

@@ -7,8 +7,10 @@
 
 #include "client/cell/cell_config.h"
 #include "client/cell/part_outputs.h"
+#include "client/cell/part_recorder.h"
 #include "client/cell/report_context.h"
 #include "client/cli/commands.h"
+#include "client/cli/db_args.h"
 #include "client/cli/remote_args.h"
 #include "core/io/io_mesh.h"
 #include "core/io/io_point_cloud.h"
@@ -19,13 +21,25 @@ namespace surfinspect::cli {
 namespace {
 
 struct InspectArgs {
-  std::string cell, scans, out, part_id, plan;
+  std::string cell, scans, out, part_id, plan, db;
   double tolerance = 0;
   RemoteArgs remote;
 };
 
+// Records the part from the files just written (client/cell/part_recorder.h).
+void Record(ResultsStore& store, const InspectArgs& a, const client::CellConfig& cell,
+            const TriangleMesh& part, const std::string& part_id) {
+  client::RecordContext context =
+      client::RecordContextOf(cell, std::shared_ptr<const MeshIndex>(Take(MeshIndex::Build(part))));
+  if (!a.plan.empty()) context.plan_hash = client::PlanHash(Take(client::ReadPlanJson(a.plan)));
+  const bool written = Take(client::RecordPartFromFiles(store, context, part_id, a.out));
+  std::printf("%s %s in %s\n", part_id.c_str(), written ? "recorded" : "was already recorded",
+              store.Name().c_str());
+}
+
 void Inspect(const InspectArgs& a) {
   const client::CellConfig cell = Take(client::ReadCellConfig(a.cell));
+  const std::unique_ptr<ResultsStore> store = a.db.empty() ? nullptr : OpenStore(a.db, false);
   const auto part_ptr = std::make_shared<const TriangleMesh>(Take(ReadMesh(cell.part_mesh)));
   const TriangleMesh& part = *part_ptr;
   InspectionSettings settings = client::InspectionSettingsOf(cell);
@@ -73,6 +87,7 @@ void Inspect(const InspectArgs& a) {
               outputs.verdict.c_str(), outputs.min_mm, outputs.max_mm, a.out.c_str());
   for (const std::string& line : outputs.failed) std::printf("  failed %s\n", line.c_str());
   for (const std::string& line : outputs.defects) std::printf("  defect %s\n", line.c_str());
+  if (store) Record(*store, a, cell, part, part_id);
 }
 
 }  // namespace
@@ -91,6 +106,7 @@ void AddInspectCommand(CLI::App& app) {
   cmd->add_option("--plan", a->plan,
                   "inspection plan JSON (docs/inspection-plan.md); default: the cell's plan");
   AddRemoteOptions(cmd, a->remote);
+  AddDbOption(cmd, a->db, "also record the part in this results database");
   cmd->callback([a] { Inspect(*a); });
 }
 

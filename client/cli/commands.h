@@ -34,5 +34,6 @@ void AddInspectCommand(CLI::App& app);
 void AddHealthCommand(CLI::App& app);
 void AddErrorMapCommand(CLI::App& app);
 void AddAcceptanceCommand(CLI::App& app);
+void AddTrendCommand(CLI::App& app);
 
 }  // namespace surfinspect::cli

@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   surfinspect::cli::AddHealthCommand(app);
   surfinspect::cli::AddErrorMapCommand(app);
   surfinspect::cli::AddAcceptanceCommand(app);
+  surfinspect::cli::AddTrendCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

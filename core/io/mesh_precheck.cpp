@@ -1,6 +1,8 @@
 #include "core/io/mesh_precheck.h"
 
+#include <algorithm>
 #include <cstring>
+#include <iterator>
 
 #include "absl/strings/str_cat.h"
 #include "core/io/obj_lines.h"
@@ -172,14 +174,22 @@ absl::Status CheckObjLine(const std::vector<std::string_view>& tok, const ObjCou
   const auto bad = [&](absl::string_view why) {
     return Refuse(name, absl::StrCat("OBJ line ", line, ": ", why));
   };
+  // Polygonal OBJ only. Assimp dispatches on a line's first characters, so a
+  // statement that merely starts like a known one ("v0...") reaches parsers
+  // that were not written for it: every statement must be one of these.
+  static constexpr std::string_view kKnown[] = {"v", "vt", "vn", "vp", "f",      "l",
+                                                "p", "g",  "o",  "s",  "mtllib", "usemtl"};
+  if (std::find(std::begin(kKnown), std::end(kKnown), key) == std::end(kKnown))
+    return bad(absl::StrCat("unsupported statement '", Excerpt(key),
+                            "' (polygonal OBJ: v vt vn vp f l p g o s mtllib usemtl)"));
   double d;
-  if (key == "v" || key == "vt" || key == "vn") {
-    const std::size_t lo = key == "vt" ? 1 : 3, hi = key == "v" ? 7 : 3;
+  if (key == "v" || key == "vt" || key == "vn" || key == "vp") {
+    const std::size_t lo = key == "vt" || key == "vp" ? 1 : 3, hi = key == "v" ? 7 : 3;
     if (tok.size() - 1 < lo || tok.size() - 1 > hi)
       return bad(absl::StrCat("'", ToAbsl(key), "' needs ", lo, " to ", hi, " numbers"));
     for (std::size_t k = 1; k < tok.size(); ++k)
       if (!ParseDouble(tok[k], &d)) return bad(absl::StrCat("bad number '", Excerpt(tok[k]), "'"));
-    ++(key == "v" ? so_far->v : key == "vt" ? so_far->vt : so_far->vn);
+    if (key != "vp") ++(key == "v" ? so_far->v : key == "vt" ? so_far->vt : so_far->vn);
     return absl::OkStatus();
   }
   if (key != "f" && key != "l" && key != "p") return absl::OkStatus();

@@ -152,7 +152,8 @@ class AgentTests(unittest.TestCase):
             time.sleep(0.2)
 
     def assert_exactly_once(self, parts):
-        results = sorted(os.listdir(os.path.join(self.dir, "results")))
+        root = os.path.join(self.dir, "results")  # part folders; results.db is the store
+        results = sorted(d for d in os.listdir(root) if os.path.isdir(os.path.join(root, d)))
         self.assertEqual(results, sorted(parts))
         for p in parts:
             for f in ("report.json", "errormap.ply", "errormap.png", "deviations.csv"):

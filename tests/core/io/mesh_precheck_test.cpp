@@ -57,6 +57,18 @@ TEST(CheckStl, RefusesWithTheFacetAndTheReason) {
             absl::StatusCode::kResourceExhausted);
 }
 
+// Only polygonal statements pass; one that merely starts like a known one
+// ("v0\xff...", which made Assimp run past a 5 s fuzzing timeout) is refused.
+TEST(CheckObj, RefusesStatementsOutsidePolygonalObj) {
+  const std::string v = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  EXPECT_TRUE(CheckObj("mtllib a.mtl\no part\ns 1\nvp 0.5\n" + v + "f 1 2 3\n").ok());
+  ExpectRefused(CheckObj(v + "v0\xff\xff\xff\xff 2 9\n", {}, "p.obj"), "p.obj",
+                "line 4: unsupported statement 'v0");
+  ExpectRefused(CheckObj(v + "curv 0 1 1 2\n", {}, "p.obj"), "p.obj",
+                "unsupported statement 'curv'");
+  ExpectRefused(CheckObj(v + "vp a\n", {}, "p.obj"), "p.obj", "bad number 'a'");
+}
+
 TEST(CheckObj, ChecksIndicesAgainstWhatTheFileDeclares) {
   const std::string v = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
   EXPECT_TRUE(
