@@ -19,7 +19,8 @@ namespace surfinspect::client {
 namespace fs = std::filesystem;
 namespace {
 
-constexpr std::size_t kPlyRecord = 19;  // float x y z deviation, uchar r g b
+// WriteErrorMapPly's record: float x y z scalar_deviation quality, uchar r g b.
+constexpr std::size_t kPlyRecord = 23;
 
 // A file's modification time in the store's format.
 absl::StatusOr<std::string> ModifiedUtc(const std::string& path) {
@@ -89,7 +90,8 @@ absl::Status ReadErrorMapPly(const std::string& path, PointCloud* points,
     if (absl::ConsumePrefix(&line, "element vertex ") && !absl::SimpleAtoi(line, &count)) count = 0;
   if (end == std::string::npos ||
       header.find("format binary_little_endian 1.0\n") == std::string::npos ||
-      header.find("property float deviation\n") == std::string::npos ||
+      header.find("property float scalar_deviation\nproperty float quality\n") ==
+          std::string::npos ||
       bytes->size() - (end + 11) != count * kPlyRecord)
     return absl::DataLossError(absl::StrCat(path, ": not a surfinspect error-map PLY"));
   std::vector<Eigen::Vector3f> pts(count);

@@ -69,6 +69,11 @@ def wait_port(port, timeout=10):
     raise AssertionError(f"nothing listens on {port}")
 
 
+
+def part_folders(results):
+    """The part folders in RESULTS/ (the results store's results.db sits there too)."""
+    return sorted(e for e in os.listdir(results) if os.path.isdir(os.path.join(results, e)))
+
 class Broker:
     """mosquitto from a config file written here; persistence in DIR/data."""
 
@@ -254,7 +259,7 @@ class MqttTests(unittest.TestCase):
         time.sleep(0.3)
         code, out, err = self.agent("--mqtt", f"tcp://127.0.0.1:{broker.port}", "--simulate", "3", "--once")
         self.assertEqual(code, 0, err)
-        parts = sorted(os.listdir(os.path.join(self.dir, "results")))
+        parts = part_folders(os.path.join(self.dir, "results"))
         self.assertEqual(len(parts), 3)
         sub.wait_for(lambda t, p: t == "surfinspect/v1/cell/status" and p["state"] == "offline",
                      what="offline status at the clean stop")
@@ -340,7 +345,7 @@ class MqttTests(unittest.TestCase):
         self.assertIn("refused the connection", err)
         self.assertIn("not authorised", err)
         self.assertIn("check the username and password file", err)
-        parts = os.listdir(os.path.join(self.dir, "results"))
+        parts = part_folders(os.path.join(self.dir, "results"))
         self.assertEqual(len(parts), 1)
         self.assertTrue(os.path.exists(os.path.join(self.dir, "results", parts[0], "report.json")))
         self.assertFalse(os.path.exists(os.path.join(self.dir, "results", parts[0], ".mqtt-delivered")))
@@ -405,7 +410,7 @@ class MqttTests(unittest.TestCase):
         code, out, err = self.agent("--simulate", "1", "--once")
         self.assertEqual(code, 0, err)
         self.assertIn("cannot reach the broker", err)
-        parts = os.listdir(os.path.join(self.dir, "results"))
+        parts = part_folders(os.path.join(self.dir, "results"))
         self.assertEqual(len(parts), 1)
         self.assertTrue(os.path.exists(os.path.join(self.dir, "results", parts[0], "report.json")))
         print(f"unreachable broker: 1 part in {time.time() - t0:.1f} s", file=sys.stderr)

@@ -84,7 +84,8 @@ PartOutputs Outputs(const std::string& report_json) {
 TEST(PartOutputs, Report2GetsAQifBesideTheReport) {
   testing::TempDir dir;
   const std::string report =
-      R"({"schema": "surfinspect.report/2", "verdict": "pass", "characteristics": [
+      R"({"schema": "surfinspect.report/2", "verdict": "pass", "tolerance": {"band_mm": 0.1},
+        "color_range_mm": 0.2, "characteristics": [
         {"name": "surface", "type": "surface", "verdict": "pass", "reason": "ok",
          "tolerance_mm": {"lower": -0.1, "upper": 0.1}, "points": 2,
          "min_mm": -0.02, "max_mm": 0.01}]})";
@@ -99,7 +100,11 @@ TEST(PartOutputs, Report2GetsAQifBesideTheReport) {
 
 TEST(PartOutputs, OtherReportSchemasGetNoQifAndTheRestIsWritten) {
   testing::TempDir dir;
-  ASSERT_TRUE(WritePartOutputs(dir.path(), Outputs(R"({"tolerance": {"band_mm": 0.1}})")).ok());
+  ASSERT_TRUE(
+      WritePartOutputs(
+          dir.path(),
+          Outputs(R"({"tolerance": {"band_mm": 0.1}, "color_range_mm": 0.2, "verdict": "pass"})"))
+          .ok());
   EXPECT_FALSE(std::filesystem::exists(dir.File("result.qif")));
   EXPECT_TRUE(std::filesystem::exists(dir.File("report.json")));
   EXPECT_TRUE(std::filesystem::exists(dir.File("errormap.ply")));
@@ -108,7 +113,8 @@ TEST(PartOutputs, OtherReportSchemasGetNoQifAndTheRestIsWritten) {
 TEST(PartOutputs, ABadReport2IsAnErrorAndNoReportIsWritten) {
   testing::TempDir dir;
   const auto st = WritePartOutputs(
-      dir.path(), Outputs(R"({"schema": "surfinspect.report/2", "verdict": "maybe"})"));
+      dir.path(), Outputs(R"({"schema": "surfinspect.report/2", "verdict": "maybe",)"
+                          R"( "tolerance": {"band_mm": 0.1}, "color_range_mm": 0.2})"));
   EXPECT_EQ(st.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_FALSE(std::filesystem::exists(dir.File("report.json")));  // the part is not complete
 }
