@@ -13,8 +13,10 @@ namespace {
 
 constexpr int kW = 720, kH = 200, kPad = 40;
 
-std::string Fmt(double v, const char* f = "%.4f") {
-  return std::isfinite(v) ? absl::StrFormat(f, v) : std::string("&ndash;");
+// `digits` after the point, with a sign when `sign`; a dash when not finite.
+std::string Fmt(double v, int digits = 4, bool sign = false) {
+  if (!std::isfinite(v)) return "&ndash;";
+  return sign ? absl::StrFormat("%+.*f", digits, v) : absl::StrFormat("%.*f", digits, v);
 }
 
 // A chart of `y` against the part index with horizontal lines at `lines`
@@ -61,11 +63,11 @@ std::string Section(const CharacteristicTrend& c) {
       "<th>&sigma; overall mm</th><th>Cp</th><th>Cpk</th><th>Pp</th><th>Ppk</th>",
       "<th>slope mm/part (95% CI)</th></tr><tr><td>[", Fmt(c.lower_mm), ", ", Fmt(c.upper_mm),
       "]</td><td>", Fmt(s.mean_mm), "</td><td>", Fmt(s.sigma_within_mm), "</td><td>",
-      Fmt(s.sigma_overall_mm), "</td><td>", Fmt(s.cp, "%.2f"), "</td><td>", Fmt(s.cpk, "%.2f"),
-      "</td><td>", Fmt(s.pp, "%.2f"), "</td><td>", Fmt(s.ppk, "%.2f"), "</td><td>");
+      Fmt(s.sigma_overall_mm), "</td><td>", Fmt(s.cp, 2), "</td><td>", Fmt(s.cpk, 2), "</td><td>",
+      Fmt(s.pp, 2), "</td><td>", Fmt(s.ppk, 2), "</td><td>");
   if (c.drift)
-    absl::StrAppend(&html, Fmt(c.drift->slope_mm_per_part, "%+.5f"), " [",
-                    Fmt(c.drift->ci_lower, "%+.5f"), ", ", Fmt(c.drift->ci_upper, "%+.5f"), "]");
+    absl::StrAppend(&html, Fmt(c.drift->slope_mm_per_part, 5, true), " [",
+                    Fmt(c.drift->ci_lower, 5, true), ", ", Fmt(c.drift->ci_upper, 5, true), "]");
   absl::StrAppend(&html, "</td></tr></table>\n");
   std::vector<bool> flagged(c.values_mm.size(), false), mr_flagged(s.moving_ranges_mm.size());
   for (const RuleViolation& v : c.violations) flagged[v.index] = true;
