@@ -33,10 +33,8 @@ absl::Status FillFromReport(PartOutputs& o) {
 }
 
 // report.pdf, its maps drawn in the part frame.
-absl::Status WritePartPdf(const std::string& path, const PartOutputs& o) {
-  const nlohmann::json report = nlohmann::json::parse(o.report_json, nullptr, false);
-  if (report.is_discarded()) return absl::DataLossError("report is not valid JSON");
-  const PointCloud in_part = TransformCloud(o.merged_in_world, o.world_from_part.inverse());
+absl::Status WritePartPdf(const std::string& path, const PartOutputs& o,
+                          const nlohmann::json& report, const PointCloud& in_part) {
   PdfReportInput pdf;
   pdf.part_id = o.part_id;
   pdf.cell = o.cell;
@@ -47,10 +45,8 @@ absl::Status WritePartPdf(const std::string& path, const PartOutputs& o) {
 }
 
 // report.html: the merged points in the part frame, so they overlay the CAD.
-absl::Status WriteReportHtml(const std::string& path, const PartOutputs& o) {
-  const nlohmann::json report = nlohmann::json::parse(o.report_json, nullptr, false);
-  if (report.is_discarded()) return absl::DataLossError("report is not valid JSON");
-  const PointCloud in_part = TransformCloud(o.merged_in_world, o.world_from_part.inverse());
+absl::Status WriteReportHtml(const std::string& path, const PartOutputs& o,
+                             const nlohmann::json& report, const PointCloud& in_part) {
   HtmlReportInput in;
   in.report = &report;
   in.points_in_part = &in_part;
@@ -58,6 +54,16 @@ absl::Status WriteReportHtml(const std::string& path, const PartOutputs& o) {
   in.mesh_in_part = o.mesh_in_part.get();
   in.context = {o.part_id, o.cell, o.viewpoints};
   return WriteHtmlReport(path, in);
+}
+
+// report.pdf and report.html, drawn from one parse of the report and one
+// copy of the merged points in the part frame.
+absl::Status WritePeopleReports(const std::string& dir, const PartOutputs& o) {
+  const nlohmann::json report = nlohmann::json::parse(o.report_json, nullptr, false);
+  if (report.is_discarded()) return absl::DataLossError("report is not valid JSON");
+  const PointCloud in_part = TransformCloud(o.merged_in_world, o.world_from_part.inverse());
+  if (auto st = WritePartPdf(dir + "/report.pdf", o, report, in_part); !st.ok()) return st;
+  return WriteReportHtml(dir + "/report.html", o, report, in_part);
 }
 
 // QIF 3.0 Results beside report.json; the measured points stay in errormap.ply.
@@ -173,8 +179,7 @@ absl::Status WritePartOutputs(const std::string& dir, const PartOutputs& o) {
   if (auto st = WriteErrorMapCsv(dir + "/deviations.csv", o.merged_in_world, view); !st.ok())
     return st;
   if (auto st = WriteStringAtomically(dir + "/errormap.png", o.png); !st.ok()) return st;
-  if (auto st = WritePartPdf(dir + "/report.pdf", o); !st.ok()) return st;
-  if (auto st = WriteReportHtml(dir + "/report.html", o); !st.ok()) return st;
+  if (auto st = WritePeopleReports(dir, o); !st.ok()) return st;
   if (auto st = WriteQif(dir + "/result.qif", o); !st.ok()) return st;
   // The report last: its presence means the part's results are complete.
   return WriteStringAtomically(dir + "/report.json", o.report_json);
