@@ -39,4 +39,13 @@ for b in inspection_plan_bench; do
   "$BIN_DIR/$b" >"$tmp" || { rm -f "$tmp"; die "$b failed"; }
   mv "$tmp" "$RESULTS_DIR/$b.txt"
 done
+# report.html in headless Chromium: time to interactive and frame times.
+if command -v chromium >/dev/null; then
+  log "report_viewer_bench"
+  tmp=$(mktemp "$RESULTS_DIR/.report_viewer.XXXXXX")
+  python3 "$(dirname "$0")/report_viewer_bench.py" "$BIN_DIR" "$RESULTS_DIR/.viewer-work" 5 >"$tmp" ||
+    { rm -f "$tmp"; die "report_viewer_bench failed"; }
+  mv "$tmp" "$RESULTS_DIR/report_viewer.txt"
+  rm -rf "$RESULTS_DIR/.viewer-work"
+fi
 log "done in $(( $(date +%s) - start )) s; table: $RESULTS_DIR/latest.md"

@@ -5,6 +5,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/report/grid_thinning.h"
+#include "core/report/progressive_order.h"
 
 namespace surfinspect {
 namespace {
@@ -88,7 +89,8 @@ absl::StatusOr<HtmlPayload> BuildHtmlPayload(const PointCloud& points_in_part,
   out.per_cell = thin.per_cell;
   std::vector<Eigen::Vector3f> shown_xyz;
   shown_xyz.reserve(thin.kept.size());
-  for (uint32_t j : thin.kept) {
+  // Stored so that every prefix is an even preview (progressive_order.h).
+  for (uint32_t j : ProgressiveOrder(all.xyz, thin.kept)) {
     out.source.push_back(finite[j]);
     shown_xyz.push_back(xyz[j]);
   }

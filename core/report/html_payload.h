@@ -13,6 +13,9 @@
 // prefix of 3s bits names a cell of the 2^s grid. Statistics never come from
 // the payload: the report's are over all points.
 //
+// Order: the shown points are stored in core/report/progressive_order.h's
+// order, so that every prefix is an evenly spread preview of all of them.
+//
 // Packing: positions are quantised to 16 bits per axis inside the shown
 // points' bounding box (error at most half a step, extent / 131070 mm per
 // axis); deviations to int16 in steps of max |deviation| / 32767 (error at
@@ -58,7 +61,7 @@ struct HtmlPayload {
   bool thinned = false;
   int per_cell = 0;              // points kept per cell, largest |deviation| first
   double cell_mm = 0;            // largest edge of the thinning cell (0 unthinned)
-  std::vector<uint32_t> source;  // input index of each shown point
+  std::vector<uint32_t> source;  // input index of each shown point, progressive order
   QuantisedPositions positions;
   double deviation_step_mm = 0;                 // d = q * step
   std::vector<int16_t> deviation;               // per shown point

@@ -131,6 +131,19 @@ class DevTools:
             self.eval("1")
             time.sleep(0.05)
 
+    def settle(self, what, seconds=30):
+        """Waits until the viewer has drawn its full point set and has
+        nothing pending (viewer.js: state.settled)."""
+        end = time.time() + seconds
+        while time.time() < end:
+            try:
+                if self.eval("!!(window.surfinspect && window.surfinspect.settled)"):
+                    return
+            except RuntimeError:  # the page is still navigating
+                pass
+            time.sleep(0.05)
+        fail("the viewer did not settle in %d s after %s" % (seconds, what))
+
     def click(self, x, y):
         for kind in ("mouseMoved", "mousePressed", "mouseReleased"):
             self.call("Input.dispatchMouseEvent", type=kind, x=x, y=y, button="left",
@@ -340,7 +353,16 @@ def main():
         # beyond it something is wrong.
         if state["tti_ms"] > 20000:
             fail("time to interactive %.0f ms" % state["tti_ms"])
-        dt.pump(0.5)
+        dt.settle("loading")
+        state = dt.eval("window.surfinspect")
+        dt.eval("window.surfinspect.frame_ms('preview')")  # waits out the frame still queued
+        preview_ms = dt.eval("window.surfinspect.frame_ms('preview')")
+        full_ms = dt.eval("window.surfinspect.frame_ms('full')")  # last: the screenshots show it
+        print("the full set (%d points) was drawn %d ms after the %d-point first frame; "
+              "a preview frame takes %.0f ms, a full frame %.0f ms" %
+              (state["shown"], state["timings"]["full"] - state["timings"]["rendered"],
+               state["preview_points"], preview_ms, full_ms), flush=True)
+        dt.pump(0.3)
         checks(dt, shots, report, state)
     finally:
         proc.terminate()
@@ -381,7 +403,7 @@ def checks(dt, shots, report, state):
     # 2. a click on the first defect row flies the camera there
     row = rect_of(dt, 'tr.defect[data-defect="1"]')
     dt.click(row["x"] + row["width"] / 2, row["y"] + row["height"] / 2)
-    dt.pump(1.0)
+    dt.settle("the click on defect row 1")
     if not dt.eval("document.querySelector('tr.defect[data-defect=\"1\"]').classList.contains('selected')"):
         fail("the clicked defect row is not selected")
     path2, view2, _ = check_drawn(dt, shots, "2_defect1")
@@ -410,7 +432,7 @@ def checks(dt, shots, report, state):
     # 4. a standard-view button changes the picture again
     top = rect_of(dt, 'button[data-view="top"]')
     dt.click(top["x"] + top["width"] / 2, top["y"] + top["height"] / 2)
-    dt.pump(1.0)
+    dt.settle("the click on 'top'")
     path3, view3, _ = check_drawn(dt, shots, "3_top")
     changed = sum(1 for a, b in zip(view2, view3) if not near(a, b, 8)) / len(view2)
     print("screenshot %s: %.1f%% of the canvas changed after the 'top' button" % (path3, 100 * changed), flush=True)

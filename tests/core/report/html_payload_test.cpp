@@ -77,6 +77,28 @@ TEST(HtmlPayload, ThinningKeepsTheCapAndThePeak) {
   EXPECT_NEAR(lowest, -2.5, p->deviation_step_mm);
 }
 
+// The viewer draws a prefix as its preview: a raster-scanned sheet's first
+// eighth, in payload order, reaches every part of the sheet.
+TEST(HtmlPayload, EveryPrefixIsAnEvenPreview) {
+  Cloud c;
+  for (int j = 0; j < 200; ++j)
+    for (int i = 0; i < 300; ++i) {
+      c.points.points.emplace_back(i * 0.5f, j * 0.5f, 0.01f * i);
+      c.deviation.push_back(0.0f);
+    }
+  c.points.width = 300;
+  c.points.height = 200;
+  auto p = BuildHtmlPayload(c.points, c.deviation, MakeDeviationPalette(0.3, 1.0), nullptr);
+  ASSERT_TRUE(p.ok()) << p.status();
+  ASSERT_EQ(p->source.size(), 60000u);
+  int quadrant[4] = {0, 0, 0, 0};
+  for (std::size_t i = 0; i < 60000 / 8; ++i) {
+    const Eigen::Vector3d q = p->positions.Decode(i);
+    ++quadrant[(q.x() >= 75.0) + 2 * (q.y() >= 50.0)];
+  }
+  for (int count : quadrant) EXPECT_NEAR(count, 60000 / 32, 60000 / 32 / 10);
+}
+
 TEST(HtmlPayload, MeshIsQuantisedInItsOwnBox) {
   Cloud c = RandomCloud(10, 3);
   TriangleMesh mesh;
