@@ -80,11 +80,14 @@ def make_cells(root, names):
     return dirs
 
 
+def agent_command(cell_dir, server, db, *extra):
+    return [os.path.join(BIN, "cell-agent"), "run", "--cell", os.path.join(cell_dir, "cell.json"),
+            "--cell-dir", cell_dir, "--server", server, "--db", db, "--poll", "0.2", *extra]
+
+
 def agent(cell_dir, server, db, *extra):
-    return subprocess.Popen(
-        [os.path.join(BIN, "cell-agent"), "run", "--cell", os.path.join(cell_dir, "cell.json"),
-         "--cell-dir", cell_dir, "--server", server, "--db", db, "--poll", "0.2", *extra],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    return subprocess.Popen(agent_command(cell_dir, server, db, *extra),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
 def trend(db, cell, root):
