@@ -47,14 +47,18 @@ void RunTrend(const TrendArgs& a) {
     throw CommandFailed(store->Name() + ": no parts match the selection (" + SelectionText(a) +
                         ")");
   const Trend trend = Take(ComputeTrend(parts, a.characteristic));
-  std::string png;
-  if (!a.mesh.empty()) {
+  const std::string title = "Process trend: " + SelectionText(a);
+  std::string html, png;
+  if (a.mesh.empty()) {
+    html = TrendHtml(trend, title, "");
+  } else {  // the map in 3D on the page; as a picture only when asked for
     const TriangleMesh mesh = Take(ReadMesh(a.mesh));
-    png = Take(EncodePng(Take(RenderTrendMap(trend.map, mesh))));
+    html = Take(TrendViewerHtml(trend, title, mesh));
+    if (!a.png.empty()) png = Take(EncodePng(Take(RenderTrendMap(trend.map, mesh))));
   }
   const nlohmann::json selection = {
       {"cell", a.cell}, {"characteristic", a.characteristic}, {"last", a.last}, {"since", a.since}};
-  Check(WriteStringAtomically(a.out, TrendHtml(trend, "Process trend: " + SelectionText(a), png)));
+  Check(WriteStringAtomically(a.out, html));
   if (!a.json.empty())
     Check(WriteStringAtomically(a.json, TrendJson(trend, selection).dump(2) + "\n"));
   if (!a.png.empty()) Check(WriteStringAtomically(a.png, png));
@@ -90,7 +94,8 @@ void AddTrendCommand(CLI::App& app) {
   cmd->add_option("--out", a->out, "trend.html")->required();
   cmd->add_option("--json", a->json, "trend.json (README: Part history and the process trend)");
   cmd->add_option("--png", a->png, "trend.png: the trend map on the part (needs --mesh)");
-  cmd->add_option("--mesh", a->mesh, "the part's CAD mesh, for the trend map picture");
+  cmd->add_option("--mesh", a->mesh,
+                  "the part's CAD mesh: trend.html then shows the trend map on it in 3D");
   cmd->callback([a] {
     if (a->db.empty()) throw CommandFailed("--db: no results database given");
     RunTrend(*a);

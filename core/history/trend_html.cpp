@@ -6,7 +6,11 @@
 #include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "core/report/deviation_palette.h"
 #include "core/report/html_escape.h"
+#include "core/report/html_payload.h"
+#include "core/report/viewer_assets.h"
+#include "core/report/viewer_page.h"
 
 namespace surfinspect {
 namespace {
@@ -86,7 +90,101 @@ std::string Section(const CharacteristicTrend& c) {
   return html;
 }
 
+std::string Intro(const Trend& trend) {
+  return absl::StrCat(
+      "<p>", trend.part_ids.size(), " parts, from ", HtmlEscape(trend.part_ids.front()), " to ",
+      HtmlEscape(trend.part_ids.back()),
+      ". Values in mm; &sigma; within = MR&#772;/1.128; limits at &plusmn;3&sigma; within; "
+      "the orange line is the drift line.</p>\n");
+}
+
+struct MapScale {
+  double range_mm, band_mm;
+};
+
+// The largest |value| of the triangles (NaN skipped), at least 1 um; the
+// band a quarter of it (trend_png.cpp's rule). Taken over the values as
+// the page stores them (float), so the largest is inside the scale.
+template <typename F>
+MapScale ScaleOf(const TrendMap& map, F value) {
+  double largest = 0;
+  for (const TriangleTrend& t : map.triangles) {
+    const double v = static_cast<float>(value(t));
+    if (std::isfinite(v)) largest = std::max(largest, std::abs(v));
+  }
+  const double range = std::max(largest, 1e-3);
+  return {range, range / 4};
+}
+
+// Per triangle of the mesh: mean, sigma (NaN without), part count and the
+// palette index of each (index 0 where there is no value).
+absl::StatusOr<nlohmann::json> TrendMapData(const TrendMap& map, std::size_t num_triangles,
+                                            std::string& blob) {
+  std::vector<float> mean(num_triangles, NAN), sigma(num_triangles, NAN);
+  std::vector<uint32_t> parts(num_triangles, 0);
+  for (const TriangleTrend& t : map.triangles) {
+    if (t.triangle_id >= num_triangles)
+      return absl::InvalidArgumentError(absl::StrCat("trend map: triangle ", t.triangle_id,
+                                                     " is not in the mesh of ", num_triangles,
+                                                     " triangles"));
+    mean[t.triangle_id] = static_cast<float>(t.mean_mm);
+    sigma[t.triangle_id] = static_cast<float>(t.sigma_mm);
+    parts[t.triangle_id] = t.parts;
+  }
+  const MapScale m = ScaleOf(map, [](const TriangleTrend& t) { return t.mean_mm; });
+  const MapScale s = ScaleOf(map, [](const TriangleTrend& t) { return t.sigma_mm; });
+  // The colours depend only on where a value lies in its scale
+  // (DeviationColor), so one palette serves both.
+  const DeviationPalette mean_palette = MakeDeviationPalette(m.band_mm, m.range_mm);
+  const DeviationPalette sigma_palette = MakeDeviationPalette(s.band_mm, s.range_mm);
+  std::vector<uint8_t> mean_index(num_triangles), sigma_index(num_triangles);
+  for (std::size_t t = 0; t < num_triangles; ++t) {
+    mean_index[t] = PaletteIndex(mean_palette, mean[t]);
+    sigma_index[t] = PaletteIndex(sigma_palette, sigma[t]);
+  }
+  return nlohmann::json{{"parts", map.parts},
+                        {"triangles_with_points", map.triangles.size()},
+                        {"mean_range_mm", m.range_mm},
+                        {"mean_band_mm", m.band_mm},
+                        {"sigma_range_mm", s.range_mm},
+                        {"sigma_band_mm", s.band_mm},
+                        {"palette", PaletteJson(mean_palette)},
+                        {"mean_mm", AppendToPayload(blob, mean)},
+                        {"sigma_mm", AppendToPayload(blob, sigma)},
+                        {"parts_per_triangle", AppendToPayload(blob, parts)},
+                        {"mean_index", AppendToPayload(blob, mean_index)},
+                        {"sigma_index", AppendToPayload(blob, sigma_index)}};
+}
+
 }  // namespace
+
+absl::StatusOr<std::string> TrendViewerHtml(const Trend& trend, const std::string& title,
+                                            const TriangleMesh& mesh) {
+  std::string blob;
+  auto map = TrendMapData(trend.map, mesh.num_triangles(), blob);
+  if (!map.ok()) return map.status();
+  std::vector<uint32_t> triangles;
+  triangles.reserve(3 * mesh.num_triangles());
+  for (const Triangle& t : mesh.triangles) triangles.insert(triangles.end(), t.begin(), t.end());
+  nlohmann::json data = {{"kind", "trend_map"},
+                         {"palette", (*map)["palette"]},
+                         {"mesh", MeshJson(QuantisePositions(mesh.vertices), triangles, blob)},
+                         {"trend", std::move(*map)},
+                         {"three", std::string(GetViewerAssets().three_version)}};
+  data["trend"].erase("palette");
+  std::string side = absl::StrCat("<aside id=\"side\">\n", Intro(trend));
+  for (const CharacteristicTrend& c : trend.characteristics) side += Section(c);
+  return absl::StrCat(
+      ViewerHead(title), "<header class=\"banner trend\"><span class=\"verdict\">TREND</span>",
+      "<span>", HtmlEscape(title), "</span><span class=\"reason\">", trend.part_ids.size(),
+      " parts</span></header>\n<main class=\"trend\">\n",
+      ViewerPane("<label><input type=\"radio\" name=\"trend-mode\" value=\"mean\" checked> mean"
+                 "</label><label><input type=\"radio\" name=\"trend-mode\" value=\"sigma\"> "
+                 "&sigma;</label>"),
+      side, "</aside>\n</main>\n<footer>surfinspect process trend, three.js ",
+      GetViewerAssets().three_version, "</footer>\n",
+      ViewerScripts(data, absl::Base64Escape(blob)));
+}
 
 std::string TrendHtml(const Trend& trend, const std::string& title, const std::string& map_png) {
   std::string html = absl::StrCat(
@@ -94,10 +192,7 @@ std::string TrendHtml(const Trend& trend, const std::string& title, const std::s
       "</title><style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}"
       "td,th{border:1px solid #aaa;padding:2px 8px}.alarm{color:#d00}</style></head><body>\n"
       "<h1>",
-      HtmlEscape(title), "</h1>\n<p>", trend.part_ids.size(), " parts, from ",
-      HtmlEscape(trend.part_ids.front()), " to ", HtmlEscape(trend.part_ids.back()),
-      ". Values in mm; &sigma; within = MR&#772;/1.128; limits at &plusmn;3&sigma; within; "
-      "the orange line is the drift line.</p>\n");
+      HtmlEscape(title), "</h1>\n", Intro(trend));
   for (const CharacteristicTrend& c : trend.characteristics) html += Section(c);
   if (!map_png.empty())
     absl::StrAppend(&html, "<h2>Process trend map</h2>\n<p>Mean deviation per CAD triangle over ",

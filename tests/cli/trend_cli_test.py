@@ -104,7 +104,11 @@ def main():
         expect(f.read(8) == b"\x89PNG\r\n\x1a\n", "trend.png is a PNG")
     with open(os.path.join(work, "trend.html")) as f:
         html = f.read()
-    expect("<svg" in html and "data:image/png;base64," in html, "trend.html charts and map")
+    expect("<svg" in html and '"kind":"trend_map"' in html, "trend.html: charts and the 3D map")
+    p = cli("trend", "--db", "results.db", "--out", "plain.html", cwd=work)
+    with open(os.path.join(work, "plain.html")) as f:
+        plain = f.read()
+    expect("<svg" in plain and "<script" not in plain, "trend.html without --mesh: charts only")
     p = cli("trend", "--db", "results.db", "--out", "last.html", "--json", "last.json",
             "--last", "4", "--characteristic", "centre", cwd=work)
     with open(os.path.join(work, "last.json")) as f:

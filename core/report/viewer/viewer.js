@@ -1,10 +1,17 @@
-// The HTML report's 3D viewer (core/report/html_report.h). Reads the page's
-// data (<script id="si-data">, JSON) and payload (<script id="si-payload">,
-// base64 of little-endian typed arrays, core/report/html_payload.h) and shows
-// the measured points in the part frame, coloured by the error map's palette
-// index computed in C++, the CAD mesh as a translucent overlay, the defects
-// with their ids, and a colour legend in mm. window.surfinspect reports
-// `ready` and the time it took (ms since navigation start) for tests.
+// The 3D viewer of surfinspect's pages (core/report/viewer_page.h). Reads the
+// page's data (<script id="si-data">, JSON) and payload (<script
+// id="si-payload">, base64 of little-endian typed arrays) and shows, by
+// data.kind:
+// - 'report' (report.html, core/report/html_report.h): the measured points
+//   in the part frame, coloured by the error map's palette index computed in
+//   C++ (core/report/html_payload.h), the CAD mesh as a translucent overlay,
+//   the defects with their ids;
+// - 'trend_map' (trend.html, core/history/trend_html.h): the CAD mesh with
+//   each triangle coloured by its mean deviation over the parts, or by its
+//   sigma, indices again computed in C++.
+// Both have a colour legend in mm and show the value under the pointer.
+// window.surfinspect reports `ready` and the time it took (ms since
+// navigation start) for tests.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 
@@ -45,9 +52,8 @@ function typed(bytes, [offset, length], Type) {
 
 // The palette index of a deviation, as core/report/deviation_palette.cpp
 // computes it; used to draw the legend (points carry their index).
-function paletteIndex(d) {
+function paletteIndex(d, tol, range) {
   if (Number.isNaN(d)) return 0;
-  const tol = data.tolerance_mm, range = data.range_mm;
   const bin = (f) => Math.min(RUN - 1, Math.max(0, Math.floor(f * RUN)));
   if (Math.abs(d) <= tol) return 86 + bin((d / tol + 1) / 2);
   const s = range > tol ? (Math.abs(d) - tol) / (range - tol) : 1;
@@ -117,32 +123,36 @@ function buildMesh(bytes, centre) {
   return new THREE.Mesh(geometry, material);
 }
 
-function drawLegend(canvas) {
+// scale: {tol, range, signed, title, none}: the colour bar of paletteIndex
+// over [-range, range] (or [0, range] when not signed), ticks at the band and
+// range ends, and the colour of `none` (no value).
+function drawLegend(canvas, scale) {
   const g = canvas.getContext('2d');
   const { width: w, height: h } = canvas;
-  const range = data.range_mm, tol = data.tolerance_mm, span = 1.12 * range;
+  const { range, tol } = scale, span = 1.12 * range, low = scale.signed ? -span : 0;
   const top = 14, bottom = h - 40, barX = 8, barW = 22;
-  const yOf = (d) => top + ((span - d) / (2 * span)) * (bottom - top);
+  const yOf = (d) => top + ((span - d) / (span - low)) * (bottom - top);
+  g.clearRect(0, 0, w, h);
   g.fillStyle = 'rgba(255,255,255,0.9)';
   g.fillRect(0, 0, w, h);
   for (let y = top; y < bottom; ++y) {
-    const d = span - ((y - top + 0.5) / (bottom - top)) * 2 * span;
-    g.fillStyle = rgb(paletteIndex(d));
+    const d = span - ((y - top + 0.5) / (bottom - top)) * (span - low);
+    g.fillStyle = rgb(paletteIndex(d, tol, range));
     g.fillRect(barX, y, barW, 1);
   }
   g.fillStyle = '#111';
   g.font = '11px sans-serif';
   g.textBaseline = 'middle';
-  for (const d of [range, tol, 0, -tol, -range]) {
+  for (const d of scale.signed ? [range, tol, 0, -tol, -range] : [range, tol, 0]) {
     const y = yOf(d);
     g.fillRect(barX + barW, Math.round(y), 5, 1);
-    g.fillText(`${d > 0 ? '+' : ''}${+d.toPrecision(4)} mm`, barX + barW + 8, y);
+    g.fillText(`${d > 0 && scale.signed ? '+' : ''}${+d.toPrecision(4)} mm`, barX + barW + 8, y);
   }
   g.fillStyle = rgb(0);
   g.fillRect(barX, h - 30, barW, 12);
   g.fillStyle = '#111';
-  g.fillText('unmatched', barX + barW + 8, h - 24);
-  g.fillText('deviation', barX, 6);
+  g.fillText(scale.none, barX + barW + 8, h - 24);
+  g.fillText(scale.title, barX, 6);
 }
 
 const VIEWS = {
@@ -150,44 +160,31 @@ const VIEWS = {
   back: [0, 1, 0], left: [-1, 0, 0], right: [1, 0, 0],
 };
 
-function main() {
-  const viewer = document.getElementById('viewer');
-  const note = document.getElementById('viewer-note');
-  const P = data.points;
-  note.textContent = `${P.shown.toLocaleString('en')} of ${P.finite.toLocaleString('en')} points shown` +
-    (P.thinned ? ` (thinned on a grid: up to ${P.per_cell} per ${P.cell_mm.toPrecision(3)} mm cell, ` +
-      'largest |deviation| first; the statistics are over all points)' : '') +
-    (data.mesh_omitted ? '; the CAD mesh is too large to embed' : '');
-  drawLegend(document.getElementById('legend'));
-  if (P.shown === 0) { state.ready = true; state.tti_ms = performance.now(); return; }
+// The renderer, scene, camera and controls for content of bounding radius
+// `radius` around the origin (`centre` in part coordinates).
+function createView(radius, centre) {
   THREE.ColorManagement.enabled = false; // the palette's bytes reach the screen unchanged
   const renderer = new THREE.WebGLRenderer({ antialias: false });
   renderer.outputColorSpace = THREE.LinearSRGBColorSpace;
   renderer.setPixelRatio(window.devicePixelRatio || 1);
   renderer.domElement.classList.add('gl');
-  viewer.prepend(renderer.domElement);
-  const bytes = decodeBase64(document.getElementById('si-payload').textContent);
-  mark('decoded');
-  const centre = [0, 1, 2].map((a) => P.min[a] + P.step[a] * 32767.5);
+  document.getElementById('viewer').prepend(renderer.domElement);
   const scene = new THREE.Scene();
   scene.background = new THREE.Color(0x20242a);
-  const points = buildPoints(bytes, centre);
-  scene.add(points);
-  const preview = buildPreview(points, P.shown);
-  if (preview) scene.add(preview);
-  const mesh = buildMesh(bytes, centre);
-  if (mesh) scene.add(mesh);
-  mark('built');
-  const radius = points.geometry.boundingSphere.radius || 1;
   const camera = new THREE.PerspectiveCamera(35, 1, radius / 1000, radius * 20);
   camera.up.set(0, 0, 1);
   const controls = new OrbitControls(camera, renderer.domElement);
-  const defects = addDefects(scene, centre, radius);
-  const view = {
-    renderer, scene, camera, controls, points, preview, defects, radius, centre,
+  return {
+    renderer, scene, camera, controls, points: null, preview: null, defects: [], radius, centre,
     anim: null, refine: null, dragging: false, size: [0, 0],
   };
-  wire(view, mesh);
+}
+
+// Sizes the view to its element (and keeps it so), draws the first frame
+// and declares the page ready.
+function showView(view) {
+  const viewer = document.getElementById('viewer');
+  const { renderer, camera } = view;
   const resize = () => {
     const size = [viewer.clientWidth, viewer.clientHeight];
     if (size[0] === view.size[0] && size[1] === view.size[1]) return;
@@ -211,10 +208,44 @@ function main() {
     gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));
     return performance.now() - t;
   };
-  state.shown = P.shown;
-  state.preview_points = preview ? PREVIEW_POINTS : P.shown;
+  // For tests: where part point p (mm) is on the page, in CSS pixels.
+  state.project = (p) => {
+    const v = new THREE.Vector3(...p.map((x, a) => x - view.centre[a])).project(camera);
+    const r = renderer.domElement.getBoundingClientRect();
+    return [r.left + ((v.x + 1) / 2) * r.width, r.top + ((1 - v.y) / 2) * r.height];
+  };
   state.ready = true;
   state.tti_ms = performance.now();
+}
+
+function reportMain() {
+  const note = document.getElementById('viewer-note');
+  const P = data.points;
+  note.textContent = `${P.shown.toLocaleString('en')} of ${P.finite.toLocaleString('en')} points shown` +
+    (P.thinned ? ` (thinned on a grid: up to ${P.per_cell} per ${P.cell_mm.toPrecision(3)} mm cell, ` +
+      'largest |deviation| first; the statistics are over all points)' : '') +
+    (data.mesh_omitted ? '; the CAD mesh is too large to embed' : '');
+  drawLegend(document.getElementById('legend'), {
+    tol: data.tolerance_mm, range: data.range_mm, signed: true, title: 'deviation', none: 'unmatched',
+  });
+  if (P.shown === 0) { state.ready = true; state.tti_ms = performance.now(); return; }
+  const bytes = decodeBase64(document.getElementById('si-payload').textContent);
+  mark('decoded');
+  const centre = [0, 1, 2].map((a) => P.min[a] + P.step[a] * 32767.5);
+  const points = buildPoints(bytes, centre);
+  const preview = buildPreview(points, P.shown);
+  const mesh = buildMesh(bytes, centre);
+  mark('built');
+  const view = createView(points.geometry.boundingSphere.radius || 1, centre);
+  view.points = points;
+  view.preview = preview;
+  for (const o of [points, preview, mesh]) if (o) view.scene.add(o);
+  view.defects = addDefects(view.scene, centre, view.radius);
+  wireCamera(view, (e) => pick(view, e));
+  wireReport(view, mesh);
+  state.shown = P.shown;
+  state.preview_points = preview ? PREVIEW_POINTS : P.shown;
+  showView(view);
 }
 
 function addDefects(scene, centre, radius) {
@@ -237,7 +268,7 @@ function addDefects(scene, centre, radius) {
 // Draws a frame of the given detail now.
 function draw(view, detail) {
   const full = detail === 'full' || !view.preview;
-  view.points.visible = full;
+  if (view.points) view.points.visible = full;
   if (view.preview) view.preview.visible = !full;
   render(view);
   state.detail = full ? 'full' : 'preview';
@@ -329,12 +360,25 @@ function pick(view, event) {
   state.picks += 1;
 }
 
-function wire(view, mesh) {
+// Orbit, pan and zoom, the standard views, and `pick` on hover and click.
+function wireCamera(view, onPick) {
   view.controls.addEventListener('start', () => { view.dragging = true; });
   view.controls.addEventListener('end', () => { view.dragging = false; changed(view); });
   view.controls.addEventListener('change', () => { if (!view.anim) changed(view); });
   document.querySelectorAll('#toolbar button[data-view]').forEach((b) =>
     b.addEventListener('click', () => setView(view, b.dataset.view)));
+  let pending = null, last = null;
+  const canvas = view.renderer.domElement;
+  canvas.addEventListener('pointermove', (e) => {
+    if (e.buttons) return;
+    last = e;
+    if (!pending) pending = requestAnimationFrame(() => { pending = null; onPick(last); });
+  });
+  canvas.addEventListener('click', (e) => onPick(e));
+}
+
+// report.html's switches and its defect rows.
+function wireReport(view, mesh) {
   const meshToggle = document.getElementById('mesh-toggle');
   meshToggle.disabled = !mesh;
   meshToggle.addEventListener('change', () => { if (mesh) mesh.visible = meshToggle.checked; changed(view); });
@@ -347,18 +391,98 @@ function wire(view, mesh) {
     tr.addEventListener('click', () => flyToDefect(view, tr.dataset.defect));
     tr.addEventListener('keydown', (e) => { if (e.key === 'Enter') flyToDefect(view, tr.dataset.defect); });
   });
-  let pending = null, last = null;
-  const canvas = view.renderer.domElement;
-  canvas.addEventListener('pointermove', (e) => {
-    if (e.buttons) return;
-    last = e;
-    if (!pending) pending = requestAnimationFrame(() => { pending = null; pick(view, last); });
-  });
-  canvas.addEventListener('click', (e) => pick(view, e));
+}
+
+// --- trend.html: the process trend map on the CAD mesh ---
+
+// The mesh without shared corners, so that each triangle has its own
+// colour: one colour attribute per mode ('mean', 'sigma'), from the palette
+// indices per triangle.
+function buildTrendMesh(bytes, centre) {
+  const M = data.mesh, T = data.trend;
+  const v = dequantise(typed(bytes, M.positions, Uint16Array), M.min, M.step, centre);
+  const index = typed(bytes, M.indices, Uint32Array);
+  const n = M.triangles;
+  const position = new Float32Array(9 * n);
+  for (let c = 0; c < 3 * n; ++c)
+    for (let a = 0; a < 3; ++a) position[3 * c + a] = v[3 * index[c] + a];
+  const colours = {};
+  for (const mode of ['mean', 'sigma']) {
+    const idx = typed(bytes, T[mode + '_index'], Uint8Array);
+    const rgb = new Uint8Array(9 * n);
+    for (let t = 0; t < n; ++t)
+      for (let k = 0; k < 3; ++k)
+        for (let a = 0; a < 3; ++a) rgb[9 * t + 3 * k + a] = data.palette[3 * idx[t] + a];
+    colours[mode] = new THREE.BufferAttribute(rgb, 3, true);
+  }
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.BufferAttribute(position, 3));
+  geometry.setAttribute('color', colours.mean);
+  geometry.computeBoundingSphere();
+  const mesh = new THREE.Mesh(geometry, new THREE.MeshBasicMaterial({ vertexColors: true, side: THREE.DoubleSide }));
+  mesh.userData = {
+    colours, mean: typed(bytes, T.mean_mm, Float32Array), sigma: typed(bytes, T.sigma_mm, Float32Array),
+    parts: typed(bytes, T.parts_per_triangle, Uint32Array),
+  };
+  return mesh;
+}
+
+function trendScale(mode) {
+  const T = data.trend;
+  return mode === 'mean'
+    ? { tol: T.mean_band_mm, range: T.mean_range_mm, signed: true, title: 'mean deviation', none: 'no points' }
+    : { tol: T.sigma_band_mm, range: T.sigma_range_mm, signed: false, title: 'sigma over parts', none: 'under 2 parts' };
+}
+
+function pickTriangle(view, mesh, event) {
+  const rect = view.renderer.domElement.getBoundingClientRect();
+  const ndc = new THREE.Vector2(((event.clientX - rect.left) / rect.width) * 2 - 1,
+    -((event.clientY - rect.top) / rect.height) * 2 + 1);
+  const ray = new THREE.Raycaster();
+  ray.setFromCamera(ndc, view.camera);
+  const hit = ray.intersectObject(mesh)[0];
+  const box = document.getElementById('hover');
+  if (!hit) { box.hidden = true; return; }
+  const t = hit.faceIndex, u = mesh.userData, fmt = (x) => (Number.isNaN(x) ? 'n/a' : `${x.toFixed(4)} mm`);
+  box.hidden = false;
+  box.textContent = u.parts[t] === 0 ? `triangle ${t}: no points in any part`
+    : `triangle ${t}: mean ${fmt(u.mean[t])}, sigma ${fmt(u.sigma[t])} over ${u.parts[t]} parts`;
+  state.picks += 1;
+}
+
+function trendMain() {
+  const T = data.trend, M = data.mesh;
+  document.getElementById('viewer-note').textContent =
+    `Per CAD triangle, the mean (or sigma) over ${T.parts} parts of its per-part mean deviation; ` +
+    `${T.triangles_with_points.toLocaleString('en')} of ${M.triangles.toLocaleString('en')} triangles have points.`;
+  const legend = document.getElementById('legend');
+  drawLegend(legend, trendScale('mean'));
+  const bytes = decodeBase64(document.getElementById('si-payload').textContent);
+  mark('decoded');
+  const centre = [0, 1, 2].map((a) => M.min[a] + M.step[a] * 32767.5);
+  const mesh = buildTrendMesh(bytes, centre);
+  mark('built');
+  // Unlit colours are exact but flat: the crease edges (over 30 degrees)
+  // give the part its shape.
+  const edges = new THREE.LineSegments(new THREE.EdgesGeometry(mesh.geometry, 30),
+    new THREE.LineBasicMaterial({ color: 0x101418, transparent: true, opacity: 0.45 }));
+  const view = createView(mesh.geometry.boundingSphere.radius || 1, centre);
+  view.scene.add(mesh, edges);
+  wireCamera(view, (e) => pickTriangle(view, mesh, e));
+  document.querySelectorAll('input[name="trend-mode"]').forEach((r) => r.addEventListener('change', () => {
+    mesh.geometry.setAttribute('color', mesh.userData.colours[r.value]);
+    drawLegend(legend, trendScale(r.value));
+    state.mode = r.value;
+    changed(view);
+  }));
+  state.mode = 'mean';
+  state.shown = M.triangles;
+  showView(view);
 }
 
 try {
-  main();
+  if (data.kind === 'trend_map') trendMain();
+  else reportMain();
 } catch (e) {
   state.errors.push(String(e));
   document.getElementById('viewer-note').textContent = `3D view unavailable: ${e.message}`;

@@ -101,5 +101,28 @@ TEST(Trend, HtmlAndPng) {
   EXPECT_FALSE(RenderTrendMap(bad, mesh).ok());
 }
 
+// The 3D page: the viewer's data names the page a trend map, the title is
+// escaped, and a triangle the mesh lacks is refused by name.
+// tests/report/trend_browser_test.py checks it in a browser.
+TEST(TrendViewerHtml, CarriesTheMapForTheViewer) {
+  auto trend = ComputeTrend(Parts(30, 0.005));
+  ASSERT_TRUE(trend.ok());
+  const TriangleMesh mesh =
+      testing::HeightField(0, 100, 0, 50, 3, 3, [](double, double) { return 0.0; });
+  auto html = TrendViewerHtml(*trend, "t <1>", mesh);
+  ASSERT_TRUE(html.ok()) << html.status();
+  EXPECT_NE(html->find("\"kind\":\"trend_map\""), std::string::npos);
+  EXPECT_NE(html->find("<title>t &lt;1&gt;</title>"), std::string::npos);
+  EXPECT_EQ(html->find("t <1>"), std::string::npos);
+  EXPECT_NE(html->find("name=\"trend-mode\" value=\"sigma\""), std::string::npos);
+  EXPECT_NE(html->find("Western Electric rules broken"), std::string::npos);
+  Trend bad = *trend;
+  bad.map.triangles.push_back({99, 1, 0, 0});
+  auto refused = TrendViewerHtml(bad, "t", mesh);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.status().message().find("triangle 99 is not in the mesh of 8"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace surfinspect
