@@ -170,7 +170,41 @@ void BM_Open3DDistance(benchmark::State& state, bool organized) {
 }
 #endif
 
+// Where a shuffled query's time goes (issue 19's first question): the
+// Morton order, the searches, and what QueryClosest adds on top (its 1M
+// ClosestPoint records), best of 3, for 1 and 2 threads.
+void PrintTimeSplit() {
+  const PointCloud& cloud = Get().shuffled;
+  for (const int threads : {1, kThreads}) {
+    BatchQuerySettings s;
+    s.threads = threads;
+    double order = INFINITY, search = INFINITY, each = INFINITY, full = INFINITY;
+    std::vector<float> d(cloud.size());
+    for (int rep = 0; rep < 3; ++rep) {
+      BatchQueryTiming t;
+      auto t0 = std::chrono::steady_clock::now();
+      const absl::Status st = QueryClosestEach(
+          *Get().index, cloud, Eigen::Isometry3d::Identity(), s, nullptr,
+          [&d](std::size_t i, const ClosestPoint& r) { d[i] = static_cast<float>(r.distance_mm); },
+          &t);
+      auto t1 = std::chrono::steady_clock::now();
+      auto r = QueryClosest(*Get().index, cloud, Eigen::Isometry3d::Identity(), s);
+      auto t2 = std::chrono::steady_clock::now();
+      if (!st.ok() || !r.ok()) std::printf("query failed\n");
+      order = std::min(order, t.order_seconds);
+      search = std::min(search, t.search_seconds);
+      each = std::min(each, std::chrono::duration<double>(t1 - t0).count());
+      full = std::min(full, std::chrono::duration<double>(t2 - t1).count());
+    }
+    std::printf(
+        "time split, 1M shuffled, %d thread(s): order %.3f s + search %.3f s (%.0f ns/point/thread)"
+        " = %.3f s with a float sink; QueryClosest (ClosestPoint records) %.3f s\n",
+        threads, order, search, search * threads * 1e9 / cloud.size(), each, full);
+  }
+}
+
 void PrintSummary() {
+  PrintTimeSplit();
   auto best = [](const char* k) { return g_best.count(k) ? g_best[k] : NAN; };
   std::printf("\n== summary (fastest iteration, %d threads, %zu triangles) ==\n", kThreads,
               Get().mesh.num_triangles());

@@ -27,6 +27,7 @@ namespace surfinspect {
 namespace {
 
 constexpr std::size_t kChunk = 256;  // points per chunk: the unit of work and of cancel polling
+constexpr std::size_t kPrefetchAhead = 4;  // points; a search takes ~0.5 us, a miss ~0.1 us
 
 // Spreads the low 10 bits of v to every third bit (Morton interleave).
 uint64_t Spread10(uint64_t v) {
@@ -111,6 +112,10 @@ absl::Status QueryClosestEach(const MeshIndex& index, const PointCloud& points,
     uint32_t prev_triangle = UINT32_MAX;
     const std::size_t end = std::min(n, (chunk + 1) * kChunk);
     for (std::size_t k = chunk * kChunk; k < end; ++k) {
+      // In Morton order the input is read at random: without a prefetch,
+      // the load of each point waits out a cache miss (~15% of a query).
+      if (!order.empty() && k + kPrefetchAhead < end)
+        __builtin_prefetch(&points.points[order[k + kPrefetchAhead]]);
       const std::size_t i = order.empty() ? k : order[k];
       const Eigen::Vector3f& q = points.points[i];
       if (!PointCloud::IsValid(q)) {
