@@ -6,6 +6,7 @@
 #include <map>
 #include <set>
 
+#include "absl/functional/function_ref.h"
 #include "absl/strings/str_cat.h"
 #include "core/history/store_schema.h"
 
@@ -53,6 +54,12 @@ class SqliteStore final : public ResultsStore {
   absl::Status InsertTriangles(const PartRecord& part);
   absl::Status LoadCharacteristics(std::vector<PartRecord>& parts, const PartSelection& sel);
   absl::Status LoadTriangles(std::vector<PartRecord>& parts, const PartSelection& sel);
+  // Runs `sql`, whose first two columns are the cell and the part id, with
+  // the selection bound, and calls `row` for each row of a part in `parts`;
+  // `what` names the rows in the error.
+  absl::Status ForEachPartRow(std::vector<PartRecord>& parts, const std::string& sql,
+                              const PartSelection& sel, const char* what,
+                              absl::FunctionRef<absl::Status(sqlite3_stmt*, PartRecord&)> row);
 
   Db db_;
   std::string path_;
@@ -197,56 +204,60 @@ absl::StatusOr<bool> SqliteStore::Record(const PartRecord& p) {
   return written;
 }
 
-absl::Status SqliteStore::LoadCharacteristics(std::vector<PartRecord>& parts,
-                                              const PartSelection& sel) {
+absl::Status SqliteStore::ForEachPartRow(
+    std::vector<PartRecord>& parts, const std::string& sql, const PartSelection& sel,
+    const char* what, absl::FunctionRef<absl::Status(sqlite3_stmt*, PartRecord&)> row) {
   std::map<std::string, PartRecord*> by_key;
   for (PartRecord& p : parts) by_key[StoreKey(p.cell, p.part_id)] = &p;
-  auto s = Prepare(
+  auto s = Prepare(sql);
+  if (!s.ok()) return s.status();
+  BindFilter(s->get(), sel);
+  int rc;
+  while ((rc = sqlite3_step(s->get())) == SQLITE_ROW) {
+    sqlite3_stmt* r = s->get();
+    auto it = by_key.find(StoreKey(ColumnText(r, 0), ColumnText(r, 1)));
+    if (it == by_key.end()) continue;
+    if (auto st = row(r, *it->second); !st.ok()) return st;
+  }
+  return rc == SQLITE_DONE ? absl::OkStatus() : Error(absl::StrCat("cannot read ", what));
+}
+
+absl::Status SqliteStore::LoadCharacteristics(std::vector<PartRecord>& parts,
+                                              const PartSelection& sel) {
+  return ForEachPartRow(
+      parts,
       "SELECT c.cell, c.part_id, c.name, c.type, c.value_mm, c.mean_mm, c.min_mm, c.max_mm, "
       "c.stddev_mm, c.lower_mm, c.upper_mm, c.verdict, c.points FROM characteristics c "
       "JOIN parts p ON p.cell = c.cell AND p.part_id = c.part_id" +
-      PartFilter(sel, "c") + " ORDER BY c.cell, c.part_id, c.position");
-  if (!s.ok()) return s.status();
-  BindFilter(s->get(), sel);
-  int rc;
-  while ((rc = sqlite3_step(s->get())) == SQLITE_ROW) {
-    sqlite3_stmt* r = s->get();
-    auto it = by_key.find(StoreKey(ColumnText(r, 0), ColumnText(r, 1)));
-    if (it == by_key.end()) continue;
-    CharacteristicRecord c;
-    c.name = ColumnText(r, 2);
-    c.type = ColumnText(r, 3);
-    double* values[] = {&c.value_mm,  &c.mean_mm,  &c.min_mm,  &c.max_mm,
-                        &c.stddev_mm, &c.lower_mm, &c.upper_mm};
-    for (int k = 0; k < 7; ++k) *values[k] = ColumnDouble(r, 4 + k);
-    c.verdict = ColumnText(r, 11);
-    c.points = sqlite3_column_int64(r, 12);
-    it->second->characteristics.push_back(std::move(c));
-  }
-  return rc == SQLITE_DONE ? absl::OkStatus() : Error("cannot read characteristics");
+          PartFilter(sel, "c") + " ORDER BY c.cell, c.part_id, c.position",
+      sel, "characteristics", [](sqlite3_stmt* r, PartRecord& part) -> absl::Status {
+        CharacteristicRecord c;
+        c.name = ColumnText(r, 2);
+        c.type = ColumnText(r, 3);
+        double* values[] = {&c.value_mm,  &c.mean_mm,  &c.min_mm,  &c.max_mm,
+                            &c.stddev_mm, &c.lower_mm, &c.upper_mm};
+        for (int k = 0; k < 7; ++k) *values[k] = ColumnDouble(r, 4 + k);
+        c.verdict = ColumnText(r, 11);
+        c.points = sqlite3_column_int64(r, 12);
+        part.characteristics.push_back(std::move(c));
+        return absl::OkStatus();
+      });
 }
 
 absl::Status SqliteStore::LoadTriangles(std::vector<PartRecord>& parts, const PartSelection& sel) {
-  std::map<std::string, PartRecord*> by_key;
-  for (PartRecord& p : parts) by_key[StoreKey(p.cell, p.part_id)] = &p;
-  auto s = Prepare(
+  return ForEachPartRow(
+      parts,
       "SELECT t.cell, t.part_id, t.num_triangles, t.packed FROM triangle_summaries t "
       "JOIN parts p ON p.cell = t.cell AND p.part_id = t.part_id" +
-      PartFilter(sel, "t"));
-  if (!s.ok()) return s.status();
-  BindFilter(s->get(), sel);
-  int rc;
-  while ((rc = sqlite3_step(s->get())) == SQLITE_ROW) {
-    sqlite3_stmt* r = s->get();
-    auto it = by_key.find(StoreKey(ColumnText(r, 0), ColumnText(r, 1)));
-    if (it == by_key.end()) continue;
-    it->second->num_triangles = static_cast<uint32_t>(sqlite3_column_int64(r, 2));
-    const char* blob = static_cast<const char*>(sqlite3_column_blob(r, 3));
-    auto tri = UnpackTriangles(std::string(blob ? blob : "", sqlite3_column_bytes(r, 3)));
-    if (!tri.ok()) return tri.status();
-    it->second->triangles = *std::move(tri);
-  }
-  return rc == SQLITE_DONE ? absl::OkStatus() : Error("cannot read triangle summaries");
+          PartFilter(sel, "t"),
+      sel, "triangle summaries", [](sqlite3_stmt* r, PartRecord& part) -> absl::Status {
+        part.num_triangles = static_cast<uint32_t>(sqlite3_column_int64(r, 2));
+        const char* blob = static_cast<const char*>(sqlite3_column_blob(r, 3));
+        auto tri = UnpackTriangles(std::string(blob ? blob : "", sqlite3_column_bytes(r, 3)));
+        if (!tri.ok()) return tri.status();
+        part.triangles = *std::move(tri);
+        return absl::OkStatus();
+      });
 }
 
 absl::StatusOr<std::vector<PartRecord>> SqliteStore::Load(const PartSelection& sel) {

@@ -15,6 +15,7 @@
 #include "core/simulation/demo_cell.h"
 #include "core/simulation/scan_simulator.h"
 #include "core/types/transform.h"
+#include "tests/support/plane_scan.h"
 #include "tests/support/test_meshes.h"
 
 namespace surfinspect {
@@ -249,19 +250,11 @@ Synthetic MakeSynthetic(bool organized) {
   Synthetic s;
   s.mesh = testing::HeightField(0, 100, 0, 100, 11, 11, [](double, double) { return 0.0; });
   constexpr uint32_t kSide = 360;
-  s.cloud = PointCloud::Organized(kSide, kSide);
   std::mt19937_64 rng(17);
-  std::normal_distribution<double> noise(0, 0.015);
-  auto gauss = [](double x, double y, double cx, double cy, double a, double sigma) {
-    return a * std::exp(-((x - cx) * (x - cx) + (y - cy) * (y - cy)) / (2 * sigma * sigma));
-  };
-  for (uint32_t r = 0; r < kSide; ++r)
-    for (uint32_t c = 0; c < kSide; ++c) {
-      const double x = 5 + 0.25 * c, y = 5 + 0.25 * r;
-      double z = noise(rng) + gauss(x, y, 30, 30, -0.2, 2.0) + gauss(x, y, 70, 30, 0.15, 3.0);
-      if (c >= 280 && c < 284 && r >= 260 && r < 264) z += 0.4;  // spatter
-      s.cloud.points[r * kSide + c] = Eigen::Vector3d(x, y, z).cast<float>();
-    }
+  s.cloud = testing::PlaneScan(kSide, 0.015, {{30, 30, -0.2, 2.0}, {70, 30, 0.15, 3.0}}, rng,
+                               [](uint32_t r, uint32_t c) {  // the spatter blob
+                                 return c >= 280 && c < 284 && r >= 260 && r < 264 ? 0.4 : 0.0;
+                               });
   std::uniform_int_distribution<uint32_t> pixel(0, kSide * kSide - 1);
   for (int k = 0; k < 500; ++k) s.cloud.points[pixel(rng)].z() += 0.5f;
   if (!organized) {

@@ -12,6 +12,7 @@
 #include "core/errormap/error_map_output.h"
 #include "core/errormap/plan_report.h"
 #include "core/io/io_mesh.h"
+#include "tests/support/plane_scan.h"
 #include "tests/support/temp_dir.h"
 #include "tests/support/test_meshes.h"
 
@@ -30,19 +31,8 @@ struct Scene {
 Scene MakeScene(const ErrorMapSettings& settings = {}) {
   Scene s;
   s.mesh = testing::HeightField(0, 50, 0, 50, 11, 11, [](double, double) { return 0.0; });
-  constexpr uint32_t kSide = 160;
-  s.cloud = PointCloud::Organized(kSide, kSide);
   std::mt19937_64 rng(5);
-  std::normal_distribution<double> noise(0, 0.015);
-  auto gauss = [](double x, double y, double cx, double cy, double a, double sigma) {
-    return a * std::exp(-((x - cx) * (x - cx) + (y - cy) * (y - cy)) / (2 * sigma * sigma));
-  };
-  for (uint32_t r = 0; r < kSide; ++r)
-    for (uint32_t c = 0; c < kSide; ++c) {
-      const double x = 5 + 0.25 * c, y = 5 + 0.25 * r;
-      const double z = noise(rng) + gauss(x, y, 20, 20, -0.2, 2.0) + gauss(x, y, 35, 30, 0.15, 3.0);
-      s.cloud.points[r * kSide + c] = Eigen::Vector3d(x, y, z).cast<float>();
-    }
+  s.cloud = testing::PlaneScan(160, 0.015, {{20, 20, -0.2, 2.0}, {35, 30, 0.15, 3.0}}, rng);
   auto index = MeshIndex::Build(s.mesh);
   EXPECT_TRUE(index.ok());
   auto em = ComputeErrorMap(**index, s.cloud, Eigen::Isometry3d::Identity(), settings);
