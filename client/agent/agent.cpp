@@ -103,7 +103,7 @@ PartReport CellAgent::Steps(const std::string& id, const std::atomic<bool>& stop
   return InspectAndStore(id, views, stop);
 }
 
-PartReport CellAgent::QuarantinePart(const std::string& id, const std::string& why) {
+PartReport CellAgent::QuarantinePart(const std::string& id, std::string why) {
   if (absl::Status st = Quarantine(layout_, id, why); !st.ok()) {
     quarantine_pending_[id] = why;
     return Report(PartOutcome::kRetryLater,

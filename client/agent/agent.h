@@ -116,7 +116,8 @@ class CellAgent {
 
  private:
   PartReport Steps(const std::string& id, const std::atomic<bool>& stop);
-  PartReport QuarantinePart(const std::string& id, const std::string& why);
+  // `why` by value: it may be an entry of quarantine_pending_, which this erases.
+  PartReport QuarantinePart(const std::string& id, std::string why);
   PartReport ArchiveWithoutCall(const std::string& id);
   // Reads INBOX/<id>/<viewpoint>.pcd; a report when the part ends here.
   bool ReadViews(const std::string& id, std::vector<ViewScan>* views, PartReport* report);

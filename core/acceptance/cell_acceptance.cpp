@@ -37,7 +37,7 @@ absl::Status MeasureBallBar(const Artefacts& a,
                             const WorldScanFn& scan, AcceptanceResult& r) {
   for (const BallBarPosition& bp : a.ball_bar) {
     SpacingResult s;
-    s.position = &bp;
+    s.position = bp;
     auto cloud_a = scan(bp.name, bp.a.view);
     if (!cloud_a.ok()) return cloud_a.status();
     absl::StatusOr<PointCloud> cloud_b = *cloud_a;
@@ -82,7 +82,7 @@ json CrossViewJson(const AcceptanceResult& r) {
   std::size_t n = 0, within = 0;
   double max_z = 0, sum_z2 = 0;
   for (const auto& s : r.sd) {
-    if (!s.position->cross_view() || !(s.spacing.u_sd_mm > 0)) continue;
+    if (!s.position.cross_view() || !(s.spacing.u_sd_mm > 0)) continue;
     const double z = s.spacing.sd_mm / s.spacing.u_sd_mm;
     ++n;
     within += std::abs(z) <= 3 ? 1 : 0;
@@ -139,9 +139,9 @@ absl::StatusOr<AcceptanceResult> RunAcceptance(
 json AcceptanceReportJson(const AcceptanceResult& r, const Artefacts& a) {
   json sd = json::array(), spheres = json::array(), plates = json::array();
   for (const auto& s : r.sd)
-    sd.push_back({{"position", s.position->name},
-                  {"views", {s.position->a.view, s.position->b.view}},
-                  {"cross_view", s.position->cross_view()},
+    sd.push_back({{"position", s.position.name},
+                  {"views", {s.position.a.view, s.position.b.view}},
+                  {"cross_view", s.position.cross_view()},
                   {"value", s.spacing.sd_mm},
                   {"u", s.spacing.u_sd_mm},
                   {"U", 2 * s.spacing.u_sd_mm},

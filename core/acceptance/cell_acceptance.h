@@ -37,7 +37,7 @@ struct AcceptanceFigure {
 };
 
 struct SpacingResult {
-  const BallBarPosition* position = nullptr;  // into the Artefacts given
+  BallBarPosition position;  // a copy: the result outlives the Artefacts given
   SphereSpacing spacing;
   ProbingError a, b;
   bool pass = false;
