@@ -256,7 +256,7 @@ TEST_F(AcceptanceSimulation, NoiseFreeFiguresComeBackWithin2um) {
     EXPECT_NEAR(e.pf_mm, 0.0, 0.002) << name;
     EXPECT_NEAR(e.ps_mm, PsTruth(), 0.002) << name;
   }
-  for (const auto& s : r->sd) EXPECT_NEAR(s.spacing.sd_mm, SdTruth(), 0.002) << s.position->name;
+  for (const auto& s : r->sd) EXPECT_NEAR(s.spacing.sd_mm, SdTruth(), 0.002) << s.position.name;
   for (const auto& [name, f] : r->plates)
     EXPECT_NEAR(f.f_mm, scene_->true_flatness_mm, 0.002) << name;
   EXPECT_TRUE(r->pass);
@@ -284,9 +284,9 @@ TEST_F(AcceptanceSimulation, NoisyFiguresComeBackWithinTheirUncertainty) {
   }
   for (const auto& s : r->sd) {
     std::printf("  %s SD %+.4f (truth %+.4f, U %.4f = 2 x [fit %.4f, cal %.4f])\n",
-                s.position->name.c_str(), s.spacing.sd_mm, SdTruth(), 2 * s.spacing.u_sd_mm,
+                s.position.name.c_str(), s.spacing.sd_mm, SdTruth(), 2 * s.spacing.u_sd_mm,
                 s.spacing.u_fit_mm, s.spacing.u_calibration_mm);
-    EXPECT_LE(std::abs(s.spacing.sd_mm - SdTruth()), 2 * s.spacing.u_sd_mm) << s.position->name;
+    EXPECT_LE(std::abs(s.spacing.sd_mm - SdTruth()), 2 * s.spacing.u_sd_mm) << s.position.name;
   }
   EXPECT_TRUE(r->pass);
 }
@@ -301,8 +301,8 @@ TEST_F(AcceptanceSimulation, ViewpointCalibrated30umOffFailsSDExactlyWhereItIsUs
     // A rigid offset cannot change a length seen from one view: only
     // cross-view positions with a sphere from v1 see it.
     const bool uses_v1 =
-        s.position->cross_view() && (s.position->a.view == "v1" || s.position->b.view == "v1");
-    EXPECT_EQ(s.pass, !uses_v1) << s.position->name << " SD " << s.spacing.sd_mm;
+        s.position.cross_view() && (s.position.a.view == "v1" || s.position.b.view == "v1");
+    EXPECT_EQ(s.pass, !uses_v1) << s.position.name << " SD " << s.spacing.sd_mm;
   }
   EXPECT_TRUE(r->pf.pass && r->ps.pass && r->f.pass);  // form and size do not see it
   EXPECT_FALSE(r->pass);
