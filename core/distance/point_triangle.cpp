@@ -30,6 +30,38 @@ bool Degenerate(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen:
   return longest2 == 0 || (b - a).cross(c - a).norm() <= 1e-12 * longest2;
 }
 
+// A sliver: twice the area at most kSliver times the longest edge squared.
+// Ericson's region tests subtract products of dot products (va, vb, vc
+// below); on a sliver they cancel, and for 2A / L^2 <= 1e-4 the test
+// ClosestIsTheBruteForceMinimiserOnSlivers saw them pick the wrong region,
+// off by more than the sliver's height. 1e-3 still agreed with the oracle.
+constexpr double kSliver = 1e-3;
+
+bool Sliver(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const double longest2 =
+      std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()});
+  return (b - a).cross(c - a).norm() <= kSliver * longest2;
+}
+
+// For a sliver: the face projection when it falls inside by the signs of
+// the sub-triangle areas about the normal (no products of dot products),
+// unless an edge, taken as a segment, is at least as close.
+PointTriangleResult SliverClosest(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                  const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  using F = ClosestFeature;
+  PointTriangleResult best = ClosestOnSegment(p, a, b, F::kEdgeAB, F::kVertexA, F::kVertexB);
+  for (const PointTriangleResult& r :
+       {ClosestOnSegment(p, b, c, F::kEdgeBC, F::kVertexB, F::kVertexC),
+        ClosestOnSegment(p, c, a, F::kEdgeCA, F::kVertexC, F::kVertexA)})
+    if (r.squared_distance < best.squared_distance) best = r;
+  const Eigen::Vector3d n = (b - a).cross(c - a);
+  const Eigen::Vector3d q = p - n * ((p - a).dot(n) / n.squaredNorm());
+  const bool inside = (b - q).cross(c - q).dot(n) >= 0 && (c - q).cross(a - q).dot(n) >= 0 &&
+                      (a - q).cross(b - q).dot(n) >= 0;
+  if (inside && (p - q).squaredNorm() < best.squared_distance) return Make(p, q, F::kFace);
+  return best;
+}
+
 }  // namespace
 
 PointTriangleResult ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
@@ -44,6 +76,7 @@ PointTriangleResult ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen
       if (r.squared_distance < best.squared_distance) best = r;
     return best;
   }
+  if (Sliver(a, b, c)) return SliverClosest(p, a, b, c);
   // Ericson §5.1.5: test the Voronoi regions of A, B, edge AB, C, edge CA,
   // edge BC, and finally the face, using dot products only.
   const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;

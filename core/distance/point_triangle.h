@@ -31,10 +31,11 @@ struct PointTriangleResult {
   double squared_distance = 0;  // |p - point|^2, mm^2 when the inputs are in mm
 };
 
-// Exact for any finite input. A degenerate triangle (collapsed to a segment
-// or a point, same test as TriangleMesh::IsDegenerate) has no face region:
-// the answer is then the closest of its three edges taken as segments, and
-// the feature is an edge or a vertex.
+// Exact for any finite input. A sliver (twice the area <= 1e-3 times the
+// longest edge squared) is answered by projection and segments instead of
+// Ericson's dot-product regions, which lose their precision there. A degenerate triangle (collapsed
+// to a segment or a point, same test as TriangleMesh::IsDegenerate) has no face region: the answer
+// is then the closest of its three edges taken as segments, and the feature is an edge or a vertex.
 PointTriangleResult ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
                                            const Eigen::Vector3d& b, const Eigen::Vector3d& c);
 

@@ -127,6 +127,35 @@ TEST(MeshIndex, ClosestIsTheBruteForceMinimiserOnClosedAndOpenMeshes) {
   ExpectMatchesBruteForce(sheet, OracleQueryPoints(sheet, 6));
 }
 
+// Slivers: a long edge of 50 mm and a height of 50 * 10^-k mm (k = 2..9),
+// still above TriangleMesh's degeneracy limit, at random orientations and
+// positions. Their computed normals are off by up to ~1e-16 * 10^k, and the
+// culling bounds must stay lower bounds all the same.
+TEST(MeshIndex, ClosestIsTheBruteForceMinimiserOnSlivers) {
+  std::mt19937_64 rng(31);
+  std::uniform_real_distribution<double> u(-1, 1);
+  TriangleMesh m;
+  for (int i = 0; i < 240; ++i) {
+    const Vector3d c(40 * u(rng), 40 * u(rng), 40 * u(rng));
+    const Vector3d d = Vector3d(u(rng), u(rng), u(rng)).normalized();
+    const Vector3d e = d.cross(Vector3d(u(rng), u(rng), u(rng))).normalized();
+    const double h = 50 * std::pow(10.0, -(2 + i % 8));
+    for (const Vector3d& v :
+         {Vector3d(c - 25 * d), Vector3d(c + 25 * d), Vector3d(c + (u(rng) * 20) * d + h * e)})
+      m.vertices.push_back(v.cast<float>());
+    const auto b = static_cast<uint32_t>(3 * i);
+    m.triangles.push_back({b, b + 1, b + 2});
+  }
+  ASSERT_LT(m.CountDegenerate(), m.num_triangles() / 4) << "most slivers must count as triangles";
+  std::vector<Vector3d> pts = OracleQueryPoints(m, 32);
+  // Points just off each sliver's long edge, where plane and edge bounds are closest to the truth.
+  for (std::size_t t = 0; t < m.num_triangles(); t += 3) {
+    const Vector3d a = V(m, m.triangles[t][0]), b = V(m, m.triangles[t][1]);
+    pts.push_back(0.5 * (a + b) + 1e-3 * Vector3d(u(rng), u(rng), u(rng)));
+  }
+  ExpectMatchesBruteForce(m, pts);
+}
+
 // Car-body coordinates, metres from the origin: the float query point that
 // Embree culls with is then off by ~1e-4 mm, and the search radius must be
 // padded for the exact minimiser (and every tie) to survive the culling.
