@@ -54,9 +54,8 @@ class SqliteStore final : public ResultsStore {
   absl::Status InsertTriangles(const PartRecord& part);
   absl::Status LoadCharacteristics(std::vector<PartRecord>& parts, const PartSelection& sel);
   absl::Status LoadTriangles(std::vector<PartRecord>& parts, const PartSelection& sel);
-  // Runs `sql`, whose first two columns are the cell and the part id, with
-  // the selection bound, and calls `row` for each row of a part in `parts`;
-  // `what` names the rows in the error.
+  // Runs `sql` (columns cell, part id, ...) with the selection bound and calls
+  // `row` for each row of a part in `parts`; `what` names the rows in errors.
   absl::Status ForEachPartRow(std::vector<PartRecord>& parts, const std::string& sql,
                               const PartSelection& sel, const char* what,
                               absl::FunctionRef<absl::Status(sqlite3_stmt*, PartRecord&)> row);
@@ -231,15 +230,10 @@ absl::Status SqliteStore::LoadCharacteristics(std::vector<PartRecord>& parts,
       "JOIN parts p ON p.cell = c.cell AND p.part_id = c.part_id" +
           PartFilter(sel, "c") + " ORDER BY c.cell, c.part_id, c.position",
       sel, "characteristics", [](sqlite3_stmt* r, PartRecord& part) -> absl::Status {
-        CharacteristicRecord c;
-        c.name = ColumnText(r, 2);
-        c.type = ColumnText(r, 3);
-        double* values[] = {&c.value_mm,  &c.mean_mm,  &c.min_mm,  &c.max_mm,
-                            &c.stddev_mm, &c.lower_mm, &c.upper_mm};
-        for (int k = 0; k < 7; ++k) *values[k] = ColumnDouble(r, 4 + k);
-        c.verdict = ColumnText(r, 11);
-        c.points = sqlite3_column_int64(r, 12);
-        part.characteristics.push_back(std::move(c));
+        part.characteristics.push_back(  // the columns in CharacteristicRecord's order
+            {ColumnText(r, 2), ColumnText(r, 3), ColumnDouble(r, 4), ColumnDouble(r, 5),
+             ColumnDouble(r, 6), ColumnDouble(r, 7), ColumnDouble(r, 8), ColumnDouble(r, 9),
+             ColumnDouble(r, 10), ColumnText(r, 11), sqlite3_column_int64(r, 12)});
         return absl::OkStatus();
       });
 }
@@ -254,9 +248,8 @@ absl::Status SqliteStore::LoadTriangles(std::vector<PartRecord>& parts, const Pa
         part.num_triangles = static_cast<uint32_t>(sqlite3_column_int64(r, 2));
         const char* blob = static_cast<const char*>(sqlite3_column_blob(r, 3));
         auto tri = UnpackTriangles(std::string(blob ? blob : "", sqlite3_column_bytes(r, 3)));
-        if (!tri.ok()) return tri.status();
-        part.triangles = *std::move(tri);
-        return absl::OkStatus();
+        if (tri.ok()) part.triangles = *std::move(tri);
+        return tri.status();
       });
 }
 
@@ -280,10 +273,8 @@ absl::StatusOr<std::vector<PartRecord>> SqliteStore::Load(const PartSelection& s
     parts.push_back(std::move(p));
   }
   if (st.ok() && rc != SQLITE_DONE) st = Error("cannot read parts");
-  if (st.ok()) {
-    KeepLast(parts, sel.last);
-    st = LoadCharacteristics(parts, sel);
-  }
+  if (st.ok()) KeepLast(parts, sel.last);
+  if (st.ok()) st = LoadCharacteristics(parts, sel);
   if (st.ok() && sel.with_triangles) st = LoadTriangles(parts, sel);
   Exec("COMMIT").IgnoreError();  // a read-only transaction: nothing to lose
   if (!st.ok()) return st;
