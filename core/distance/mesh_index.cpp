@@ -30,6 +30,7 @@ struct QueryState {
   const Eigen::Vector3f* vertices;
   const Triangle* triangles;
   const Eigen::Vector3d* face_normals;
+  const PrismBound* prisms;
   double coordinate_scale;
   double best_d2;  // the squared limit until a triangle is accepted
   uint32_t best_triangle = UINT32_MAX;
@@ -40,15 +41,15 @@ struct QueryState {
   bool Offer(uint32_t t) {
     const Triangle& tri = triangles[t];
     const Eigen::Vector3d a = vertices[tri[0]].cast<double>();
-    // The distance to the triangle's plane is a lower bound on the distance
-    // to the triangle: one dot product rejects most candidates. The slack,
-    // far above the rounding of either computation, keeps exact ties
-    // (points on shared edges and vertices) for the full test below.
+    // Cull by the plane, then by the prism (prism_bound.h): a triangle is
+    // skipped only when the kernel would lose to the best so far.
     const Eigen::Vector3d pa = p - a;
-    const double below = std::abs(pa.dot(face_normals[t])) - 1e-12 * pa.lpNorm<1>();
-    if (below > 0 && below * below > best_d2) return false;
-    const PointTriangleResult r = ClosestPointOnTriangle(p, a, vertices[tri[1]].cast<double>(),
-                                                         vertices[tri[2]].cast<double>());
+    const PrismBound& prism = prisms[t];
+    const double plane2 = PlaneBound2(prism, face_normals[t], pa);
+    if (plane2 > best_d2) return false;
+    const Eigen::Vector3d b = vertices[tri[1]].cast<double>(), c = vertices[tri[2]].cast<double>();
+    if (PrismBound2(prism, plane2, pa, p - b, p - c) > best_d2) return false;
+    const PointTriangleResult r = ClosestPointOnTriangle(p, a, b, c);
     const bool better =
         best_triangle == UINT32_MAX
             ? r.squared_distance <= best_d2
@@ -165,6 +166,10 @@ void MeshIndex::ComputePseudonormals() {
                           c = verts[tris[t][2]].cast<double>();
     face_normal_[t] = (b - a).cross(c - a).normalized();
   }
+  prism_.resize(tris.size());
+  for (std::size_t t = 0; t < tris.size(); ++t)
+    prism_[t] = MakePrismBound(verts[tris[t][0]].cast<double>(), verts[tris[t][1]].cast<double>(),
+                               verts[tris[t][2]].cast<double>(), face_normal_[t]);
 
   // Edges: sort (welded vertex pair, slot) and sum the face normals per run.
   std::vector<std::pair<uint64_t, uint32_t>> slots;
@@ -222,6 +227,7 @@ ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_dis
                mesh_.vertices.data(),
                mesh_.triangles.data(),
                face_normal_.data(),
+               prism_.data(),
                p_in_mesh.cwiseAbs().maxCoeff(),
                max_distance_mm * max_distance_mm,
                UINT32_MAX,
@@ -265,6 +271,7 @@ std::size_t MeshIndex::memory_bytes() const {
   return sizeof(*this) + mesh_.vertices.capacity() * sizeof(Eigen::Vector3f) +
          mesh_.triangles.capacity() * sizeof(Triangle) +
          face_normal_.capacity() * sizeof(Eigen::Vector3d) +
+         prism_.capacity() * sizeof(PrismBound) +
          triangle_edges_.capacity() * sizeof(triangle_edges_[0]) +
          edge_normal_.capacity() * sizeof(Eigen::Vector3d) + weld_.capacity() * sizeof(uint32_t) +
          vertex_normal_.capacity() * sizeof(Eigen::Vector3d) +

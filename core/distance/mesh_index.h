@@ -33,6 +33,7 @@
 #include "absl/functional/function_ref.h"
 #include "absl/status/statusor.h"
 #include "core/distance/point_triangle.h"
+#include "core/distance/prism_bound.h"
 #include "core/types/point_cloud.h"
 #include "core/types/triangle_mesh.h"
 
@@ -109,6 +110,7 @@ class MeshIndex {
   TriangleMesh mesh_;
   MeshIndexInfo info_;
   std::vector<Eigen::Vector3d> face_normal_;             // per triangle, unit or 0
+  std::vector<PrismBound> prism_;                        // per triangle: culling before the kernel
   std::vector<std::array<uint32_t, 3>> triangle_edges_;  // per triangle: edge ids of AB, BC, CA
   std::vector<Eigen::Vector3d> edge_normal_;             // per edge: sum of adjacent face normals
   std::vector<uint32_t> weld_;                           // vertex -> representative vertex

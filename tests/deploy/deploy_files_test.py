@@ -309,6 +309,8 @@ class DockerfileTest(unittest.TestCase):
         return set(words)
 
     @unittest.skipUnless(shutil.which("dpkg") and shutil.which("ldd"), "needs dpkg and ldd (Debian)")
+    @unittest.skipIf(os.environ.get("SURFINSPECT_SANITIZED") == "1",
+                     "a sanitized build links libraries the release image never ships")
     def test_runtime_packages_cover_every_library_the_binaries_need(self):
         packages = self.runtime_packages()
         essential = {"libc6", "libgcc-s1"}  # in every Debian image
