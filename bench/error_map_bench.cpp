@@ -170,7 +170,7 @@ void BM_Open3DDistance(benchmark::State& state, bool organized) {
 }
 #endif
 
-// Where a shuffled query's time goes (issue 19's first question): the
+// Where a shuffled query's time goes: the
 // Morton order, the searches, and what QueryClosest adds on top (its 1M
 // ClosestPoint records), best of 3, for 1 and 2 threads.
 void PrintTimeSplit() {
