@@ -117,9 +117,10 @@ MapScale ScaleOf(const TrendMap& map, F value) {
 }
 
 // Per triangle of the mesh: mean, sigma (NaN without), part count and the
-// palette index of each (index 0 where there is no value).
+// palette index of each (index 0 where there is no value); `palette` gets
+// the colours the indices refer to.
 absl::StatusOr<nlohmann::json> TrendMapData(const TrendMap& map, std::size_t num_triangles,
-                                            std::string& blob) {
+                                            std::string& blob, nlohmann::json& palette) {
   std::vector<float> mean(num_triangles, NAN), sigma(num_triangles, NAN);
   std::vector<uint32_t> parts(num_triangles, 0);
   for (const TriangleTrend& t : map.triangles) {
@@ -142,13 +143,13 @@ absl::StatusOr<nlohmann::json> TrendMapData(const TrendMap& map, std::size_t num
     mean_index[t] = PaletteIndex(mean_palette, mean[t]);
     sigma_index[t] = PaletteIndex(sigma_palette, sigma[t]);
   }
+  palette = PaletteJson(mean_palette);
   return nlohmann::json{{"parts", map.parts},
                         {"triangles_with_points", map.triangles.size()},
                         {"mean_range_mm", m.range_mm},
                         {"mean_band_mm", m.band_mm},
                         {"sigma_range_mm", s.range_mm},
                         {"sigma_band_mm", s.band_mm},
-                        {"palette", PaletteJson(mean_palette)},
                         {"mean_mm", AppendToPayload(blob, mean)},
                         {"sigma_mm", AppendToPayload(blob, sigma)},
                         {"parts_per_triangle", AppendToPayload(blob, parts)},
@@ -161,17 +162,17 @@ absl::StatusOr<nlohmann::json> TrendMapData(const TrendMap& map, std::size_t num
 absl::StatusOr<std::string> TrendViewerHtml(const Trend& trend, const std::string& title,
                                             const TriangleMesh& mesh) {
   std::string blob;
-  auto map = TrendMapData(trend.map, mesh.num_triangles(), blob);
+  nlohmann::json palette;
+  auto map = TrendMapData(trend.map, mesh.num_triangles(), blob, palette);
   if (!map.ok()) return map.status();
   std::vector<uint32_t> triangles;
   triangles.reserve(3 * mesh.num_triangles());
   for (const Triangle& t : mesh.triangles) triangles.insert(triangles.end(), t.begin(), t.end());
   nlohmann::json data = {{"kind", "trend_map"},
-                         {"palette", (*map)["palette"]},
+                         {"palette", std::move(palette)},
                          {"mesh", MeshJson(QuantisePositions(mesh.vertices), triangles, blob)},
                          {"trend", std::move(*map)},
                          {"three", std::string(GetViewerAssets().three_version)}};
-  data["trend"].erase("palette");
   std::string side = absl::StrCat("<aside id=\"side\">\n", Intro(trend));
   for (const CharacteristicTrend& c : trend.characteristics) side += Section(c);
   return absl::StrCat(
