@@ -99,9 +99,11 @@ ErrorMapRun LocalErrorMap(const ErrorMapArgs& a, const PointCloud& cloud_in_worl
                           const PointCloud& cloud_in_part, const Eigen::Isometry3d& world_from_part,
                           TriangleMesh mesh, const MeshTopology& topo, const InspectionPlan& plan) {
   const std::unique_ptr<MeshIndex> index = Take(MeshIndex::Build(std::move(mesh)));
-  spdlog::info("mesh index built in {:.3f} s ({} boundary edges, {} degenerate triangles)",
-               index->info().build_seconds, topo.boundary_edges,
-               index->info().degenerate_triangles);
+  spdlog::info(
+      "mesh index built in {:.3f} s ({} BVH nodes, {} search; {} boundary edges, {} degenerate "
+      "triangles)",
+      index->info().build_seconds, index->info().bvh_nodes, index->info().search_isa,
+      topo.boundary_edges, index->info().degenerate_triangles);
   ErrorMapRun run;
   run.build_seconds = index->info().build_seconds;
   run.result = Take(ComputeErrorMap(*index, cloud_in_world, world_from_part, a.settings));

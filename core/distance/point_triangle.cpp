@@ -64,10 +64,22 @@ PointTriangleResult SliverClosest(const Eigen::Vector3d& p, const Eigen::Vector3
 
 }  // namespace
 
+TriangleShape ClassifyTriangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                               const Eigen::Vector3d& c) {
+  if (Degenerate(a, b, c)) return TriangleShape::kDegenerate;
+  return Sliver(a, b, c) ? TriangleShape::kSliver : TriangleShape::kRegular;
+}
+
 PointTriangleResult ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
                                            const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  return ClosestPointOnTriangle(p, a, b, c, ClassifyTriangle(a, b, c));
+}
+
+PointTriangleResult ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                           const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                                           TriangleShape shape) {
   using F = ClosestFeature;
-  if (Degenerate(a, b, c)) {
+  if (shape == TriangleShape::kDegenerate) {
     // No face region: the closest of the three edges as segments.
     PointTriangleResult best = ClosestOnSegment(p, a, b, F::kEdgeAB, F::kVertexA, F::kVertexB);
     for (const PointTriangleResult& r :
@@ -76,7 +88,7 @@ PointTriangleResult ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen
       if (r.squared_distance < best.squared_distance) best = r;
     return best;
   }
-  if (Sliver(a, b, c)) return SliverClosest(p, a, b, c);
+  if (shape == TriangleShape::kSliver) return SliverClosest(p, a, b, c);
   // Ericson §5.1.5: test the Voronoi regions of A, B, edge AB, C, edge CA,
   // edge BC, and finally the face, using dot products only.
   const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;

@@ -31,6 +31,12 @@ struct PointTriangleResult {
   double squared_distance = 0;  // |p - point|^2, mm^2 when the inputs are in mm
 };
 
+// How the kernel answers a triangle: by Ericson's regions, as a sliver, or
+// as three segments. A mesh index classifies each triangle once.
+enum class TriangleShape : uint8_t { kRegular, kSliver, kDegenerate };
+TriangleShape ClassifyTriangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                               const Eigen::Vector3d& c);
+
 // Exact for any finite input. A sliver (twice the area <= 1e-3 times the
 // longest edge squared) is answered by projection and segments instead of
 // Ericson's dot-product regions, which lose their precision there. A degenerate triangle (collapsed
@@ -38,6 +44,10 @@ struct PointTriangleResult {
 // is then the closest of its three edges taken as segments, and the feature is an edge or a vertex.
 PointTriangleResult ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
                                            const Eigen::Vector3d& b, const Eigen::Vector3d& c);
+// The same with the shape known: `shape` must be ClassifyTriangle(a, b, c).
+PointTriangleResult ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                           const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                                           TriangleShape shape);
 
 // Index 0..2 of the edge's first vertex (AB -> 0, BC -> 1, CA -> 2) or of the
 // vertex (A -> 0, ...); -1 for kFace.

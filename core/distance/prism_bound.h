@@ -1,6 +1,6 @@
 // A cheap lower bound on the distance from a point to a triangle, which the
-// mesh index (core/distance/mesh_index.cpp) culls candidates with before the
-// exact kernel (point_triangle.h).
+// wide BVH's leaves (core/distance/wide_bvh_search.cpp) cull candidates with
+// before the exact kernel (point_triangle.h).
 //
 // With n the unit face normal and m_k the in-plane outward normal of edge k
 // (for a CCW face, edge u->v's is (v - u) x n): the triangle lies in its
@@ -14,13 +14,12 @@
 // both with a margin and lies far above the kernel's own rounding, so a
 // triangle whose bound exceeds the best distance so far would have lost to
 // it in the kernel as well (exact ties are kept). Slivers get a weaker
-// bound, never a wrong one.
+// bound, never a wrong one. The leaves store n and m_k as floats and add
+// 2e-7 to the slack for that rounding (core/distance/wide_bvh.cpp).
 #pragma once
 
 #include <Eigen/Core>
-#include <algorithm>
 #include <array>
-#include <cmath>
 
 namespace surfinspect {
 
@@ -34,21 +33,5 @@ struct PrismBound {
 // gives zero edge normals: no bound beyond 0.
 PrismBound MakePrismBound(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                           const Eigen::Vector3d& c, const Eigen::Vector3d& n);
-
-// below^2 (0 when the slack exceeds the plane distance); pa = p - a.
-inline double PlaneBound2(const PrismBound& bound, const Eigen::Vector3d& n,
-                          const Eigen::Vector3d& pa) {
-  const double below = std::abs(pa.dot(n)) - bound.slack * pa.lpNorm<1>();
-  return below > 0 ? below * below : 0.0;
-}
-
-// below^2 + out^2 from PlaneBound2's value; pa, pb, pc = p - a, p - b, p - c.
-inline double PrismBound2(const PrismBound& bound, double plane2, const Eigen::Vector3d& pa,
-                          const Eigen::Vector3d& pb, const Eigen::Vector3d& pc) {
-  const double out = std::max({bound.edge[0].dot(pa) - bound.slack * pa.lpNorm<1>(),
-                               bound.edge[1].dot(pb) - bound.slack * pb.lpNorm<1>(),
-                               bound.edge[2].dot(pc) - bound.slack * pc.lpNorm<1>()});
-  return out > 0 ? plane2 + out * out : plane2;
-}
 
 }  // namespace surfinspect

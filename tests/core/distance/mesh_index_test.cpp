@@ -10,6 +10,7 @@
 #include <atomic>
 #include <random>
 
+#include "core/distance/wide_bvh.h"
 #include "tests/support/test_meshes.h"
 
 namespace surfinspect {
@@ -87,26 +88,47 @@ std::vector<Vector3d> OracleQueryPoints(const TriangleMesh& m, uint64_t seed) {
   return pts;
 }
 
+// Every search this machine runs, with both kinds of build: the answers
+// must be the same in each.
+std::vector<MeshIndexSettings> AllSearches() {
+  std::vector<MeshIndexSettings> all;
+  for (SearchIsa isa : {SearchIsa::kSse2, SearchIsa::kAvx2})
+    for (BvhQuality quality : {BvhQuality::kLow, BvhQuality::kHigh}) {
+      if (!SearchIsaSupported(isa)) continue;
+      MeshIndexSettings s;
+      s.search_isa = isa;
+      s.build_quality = quality;
+      all.push_back(s);
+    }
+  return all;
+}
+
 void ExpectMatchesBruteForce(const TriangleMesh& m, const std::vector<Vector3d>& pts) {
-  auto index = BuildOrDie(m);
-  ASSERT_TRUE(index);
+  std::vector<std::unique_ptr<MeshIndex>> indices;
+  for (const MeshIndexSettings& s : AllSearches()) {
+    auto index = MeshIndex::Build(m, s);
+    ASSERT_TRUE(index.ok()) << index.status();
+    indices.push_back(*std::move(index));
+  }
   for (const Vector3d& p : pts) {
-    const ClosestPoint got = index->Closest(p);
     const Brute want = BruteForce(m, p);
-    ASSERT_TRUE(got.matched());
-    // Same kernel on the same doubles: the BVH must not change the answer.
-    EXPECT_EQ(got.triangle_id, want.triangle) << p.transpose();
-    EXPECT_EQ(got.distance_mm, std::sqrt(want.d2));
-    EXPECT_EQ(got.point, want.point);
-    // Independent kernel: within 1e-9 relative (1e-9 mm floor on the surface).
-    EXPECT_NEAR(got.distance_mm, want.independent, 1e-9 * std::max(1.0, want.independent));
-    EXPECT_EQ(std::abs(got.signed_distance_mm), got.distance_mm);
-    // A hint (any triangle, near or far) never changes the answer.
-    for (uint32_t hint : {want.triangle, static_cast<uint32_t>(m.num_triangles() / 2), 0u}) {
-      const ClosestPoint hinted = index->Closest(p, INFINITY, hint);
-      EXPECT_EQ(hinted.triangle_id, got.triangle_id);
-      EXPECT_EQ(hinted.distance_mm, got.distance_mm);
-      EXPECT_EQ(hinted.signed_distance_mm, got.signed_distance_mm);
+    for (const auto& index : indices) {
+      const ClosestPoint got = index->Closest(p);
+      ASSERT_TRUE(got.matched());
+      // Same kernel on the same doubles: the BVH must not change the answer.
+      EXPECT_EQ(got.triangle_id, want.triangle) << p.transpose() << " " << index->info().search_isa;
+      EXPECT_EQ(got.distance_mm, std::sqrt(want.d2));
+      EXPECT_EQ(got.point, want.point);
+      // Independent kernel: within 1e-9 relative (1e-9 mm floor on the surface).
+      EXPECT_NEAR(got.distance_mm, want.independent, 1e-9 * std::max(1.0, want.independent));
+      EXPECT_EQ(std::abs(got.signed_distance_mm), got.distance_mm);
+      // A hint (any triangle, near or far) never changes the answer.
+      for (uint32_t hint : {want.triangle, static_cast<uint32_t>(m.num_triangles() / 2), 0u}) {
+        const ClosestPoint hinted = index->Closest(p, INFINITY, hint);
+        EXPECT_EQ(hinted.triangle_id, got.triangle_id);
+        EXPECT_EQ(hinted.distance_mm, got.distance_mm);
+        EXPECT_EQ(hinted.signed_distance_mm, got.signed_distance_mm);
+      }
     }
   }
 }
@@ -116,6 +138,17 @@ TEST(MeshIndex, ClosestIsTheBruteForceMinimiserOnRandomSoups) {
     const TriangleMesh m = RandomSoup(300, seed);
     ExpectMatchesBruteForce(m, OracleQueryPoints(m, seed + 10));
   }
+}
+
+// Triangles of 10^5 mm among ones of 10^-2 mm, so boxes and bounds span
+// seven orders of magnitude.
+TEST(MeshIndex, ClosestIsTheBruteForceMinimiserAmongHugeAndTinyTriangles) {
+  TriangleMesh m = RandomSoup(200, 8);
+  for (std::size_t i = 0; i < m.vertices.size(); ++i) {
+    const float scale = i / 3 % 4 == 0 ? 5e3f : i / 3 % 4 == 1 ? 1e-3f : 1.f;
+    m.vertices[i] = m.vertices[3 * (i / 3)] + scale * (m.vertices[i] - m.vertices[3 * (i / 3)]);
+  }
+  ExpectMatchesBruteForce(m, OracleQueryPoints(m, 18));
 }
 
 TEST(MeshIndex, ClosestIsTheBruteForceMinimiserOnClosedAndOpenMeshes) {
@@ -580,7 +613,39 @@ TEST(MeshIndexBatch, OneAndManyThreadsAndCoherentStartGiveIdenticalResults) {
         ASSERT_TRUE(got.ok());
         ExpectIdentical(*reference, *got);
       }
+    // And in every instruction set and kind of build.
+    for (const MeshIndexSettings& settings : AllSearches()) {
+      auto other = MeshIndex::Build(sheet, settings);
+      ASSERT_TRUE(other.ok()) << other.status();
+      BatchQuerySettings s = serial;
+      s.threads = 2;
+      s.coherent_start = true;
+      auto got = QueryClosest(**other, *cloud, mesh_from_points, s);
+      ASSERT_TRUE(got.ok());
+      ExpectIdentical(*reference, *got);
+    }
   }
+}
+
+TEST(MeshIndex, TheSearchIsaIsReportedAndAnUnsupportedOneRejected) {
+  const TriangleMesh box = testing::Box(Vector3d::Zero(), Vector3d::Ones());
+  MeshIndexSettings s;
+  s.search_isa = SearchIsa::kSse2;
+  auto sse2 = MeshIndex::Build(box, s);
+  ASSERT_TRUE(sse2.ok());
+  EXPECT_STREQ((*sse2)->info().search_isa, "sse2");
+  EXPECT_GE((*sse2)->info().bvh_nodes, 1u);
+  s.search_isa = SearchIsa::kAvx2;
+  auto avx2 = MeshIndex::Build(box, s);
+  if (SearchIsaSupported(SearchIsa::kAvx2)) {
+    ASSERT_TRUE(avx2.ok());
+    EXPECT_STREQ((*avx2)->info().search_isa, "avx2");
+  } else {
+    EXPECT_EQ(avx2.status().code(), absl::StatusCode::kInvalidArgument);
+  }
+  auto automatic = MeshIndex::Build(box);
+  ASSERT_TRUE(automatic.ok());
+  EXPECT_STREQ((*automatic)->info().search_isa, SearchIsaName(SearchIsa::kAuto));
 }
 
 TEST(MeshIndexBatch, CancelAndBadInput) {

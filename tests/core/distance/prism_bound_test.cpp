@@ -6,11 +6,26 @@
 #include <random>
 
 #include "core/distance/point_triangle.h"
+#include "core/distance/wide_bvh.h"
 
 namespace surfinspect {
 namespace {
 
 using Eigen::Vector3d;
+using Eigen::Vector3f;
+
+// The leaf bound, as the search computes it, for one triangle in lane 1 of
+// a block (the other lanes unused); SSE2 and AVX2 must agree to the bit.
+double LeafBound2(const Vector3d& a, const Vector3d& b, const Vector3d& c, const Vector3d& n,
+                  const Vector3d& p) {
+  wide::LeafBlock block = EmptyLeafBlock();
+  FillLeafLane(block, 1, 7, a.cast<float>(), b.cast<float>(), c.cast<float>(), n);
+  double sse2[wide::kLeafWidth], avx2[wide::kLeafWidth];
+  LeafBounds2(SearchIsa::kSse2, block, p, sse2);
+  LeafBounds2(SearchIsa::kAvx2, block, p, avx2);
+  EXPECT_EQ(sse2[1], avx2[1]);
+  return sse2[1];
+}
 
 Vector3d Normal(const Vector3d& a, const Vector3d& b, const Vector3d& c) {
   const Vector3d n = (b - a).cross(c - a);
@@ -27,12 +42,12 @@ TEST(PrismBound, IsALowerBoundOfTheKernelsDistance) {
     const Vector3d a(u(rng), u(rng), u(rng)), d = Vector3d(u(rng), u(rng), u(rng)).normalized();
     const Vector3d e = d.cross(Vector3d(u(rng), u(rng), u(rng))).normalized();
     const double h = i % 2 ? std::abs(u(rng)) : std::pow(10.0, -(i % 10));
-    // Float vertices, as the mesh stores them.
-    const Vector3d b = (a + 30 * d).cast<float>().cast<double>();
-    const Vector3d c = (a + 30 * u(rng) * d + 30 * h * e).cast<float>().cast<double>();
-    const Vector3d fa = a.cast<float>().cast<double>();
+    // Float vertices, as the mesh stores them (each rounded in a statement
+    // of its own, so no expression template can skip the rounding).
+    const Vector3f af = a.cast<float>(), bf = (a + 30 * d).cast<float>(),
+                   cf = (a + 30 * u(rng) * d + 30 * h * e).cast<float>();
+    const Vector3d fa = af.cast<double>(), b = bf.cast<double>(), c = cf.cast<double>();
     const Vector3d n = Normal(fa, b, c);
-    const PrismBound bound = MakePrismBound(fa, b, c, n);
     for (int k = 0; k < 20; ++k) {
       const double scale = std::pow(10.0, static_cast<int>(k % 5) - 3);
       const Vector3d p = k == 0   ? fa
@@ -40,9 +55,7 @@ TEST(PrismBound, IsALowerBoundOfTheKernelsDistance) {
                                   : Vector3d(fa + 30 * Vector3d(u(rng), u(rng), u(rng)) +
                                              scale * Vector3d(u(rng), u(rng), u(rng)));
       const double exact = ClosestPointOnTriangle(p, fa, b, c).squared_distance;
-      const double plane2 = PlaneBound2(bound, n, p - fa);
-      const double prism2 = PrismBound2(bound, plane2, p - fa, p - b, p - c);
-      ASSERT_LE(plane2, prism2);
+      const double prism2 = LeafBound2(fa, b, c, n, p);
       ASSERT_LE(prism2, exact) << "triangle " << i << " point " << k << " h " << h;
       ++total;
       tight += prism2 >= 0.5 * exact;
@@ -56,19 +69,30 @@ TEST(PrismBound, OutsideAnEdgeTheBoundIsTheEdgeDistance) {
   const Vector3d a(0, 0, 0), b(10, 0, 0), c(0, 10, 0), n(0, 0, 1);
   const PrismBound bound = MakePrismBound(a, b, c, n);
   EXPECT_NEAR(bound.edge[0].y(), -1, 1e-15);  // AB's outward normal points away from c
-  const Vector3d p(5, -3, 4);                 // 3 outside AB, 4 above the plane
-  const double plane2 = PlaneBound2(bound, n, p - a);
-  EXPECT_NEAR(plane2, 16, 1e-9);
-  EXPECT_NEAR(PrismBound2(bound, plane2, p - a, p - b, p - c), 25, 1e-9);
+  // Lowered by the slack, 2e-7 |p - vertex|_1 per term.
+  EXPECT_NEAR(LeafBound2(a, b, c, n, Vector3d(5, 2, 4)), 16, 1e-4);  // above the face
+  const Vector3d p(5, -3, 4);  // 3 outside AB, 4 above the plane
+  EXPECT_NEAR(LeafBound2(a, b, c, n, p), 25, 1e-4);
   EXPECT_DOUBLE_EQ(ClosestPointOnTriangle(p, a, b, c).squared_distance, 25);
 }
 
 TEST(PrismBound, ADegenerateTriangleBoundsNothing) {
   const Vector3d a(0, 0, 0), b(1, 0, 0), c(2, 0, 0);
-  const PrismBound bound = MakePrismBound(a, b, c, Vector3d::Zero());
-  const Vector3d p(0, 5, 5);
-  EXPECT_EQ(PrismBound2(bound, PlaneBound2(bound, Vector3d::Zero(), p - a), p - a, p - b, p - c),
-            0.0);
+  EXPECT_EQ(LeafBound2(a, b, c, Vector3d::Zero(), Vector3d(0, 5, 5)), 0.0);
+}
+
+// Unused lanes are skipped by their triangle id, and a full block gives
+// each lane its own triangle's bound.
+TEST(PrismBound, EachLaneOfABlockIsItsOwnTriangle) {
+  wide::LeafBlock block = EmptyLeafBlock();
+  EXPECT_EQ(block.triangle[3], UINT32_MAX);
+  for (int lane = 0; lane < wide::kLeafWidth; ++lane)
+    FillLeafLane(block, lane, lane, Vector3f(0, 0, lane), Vector3f(1, 0, lane),
+                 Vector3f(0, 1, lane), Vector3d(0, 0, 1));
+  double out[wide::kLeafWidth];
+  LeafBounds2(SearchIsa::kAuto, block, Vector3d(0.2, 0.2, 10), out);
+  for (int lane = 0; lane < wide::kLeafWidth; ++lane)
+    EXPECT_NEAR(out[lane], (10.0 - lane) * (10.0 - lane), 1e-4) << lane;
 }
 
 }  // namespace

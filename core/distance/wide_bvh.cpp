@@ -1,0 +1,279 @@
+#include "core/distance/wide_bvh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <new>
+
+#include "absl/strings/str_cat.h"
+#include "core/distance/point_triangle.h"
+#include "core/distance/prism_bound.h"
+
+namespace surfinspect {
+namespace {
+
+// What Embree's callbacks build: nodes and leaves in its thread-local
+// memory, freed with the RTCBVH once copied into the flat layout.
+struct BuildItem {
+  bool leaf;
+  uint32_t count;
+};
+struct BuildNode {
+  BuildItem item;
+  void* child[wide::kWidth];
+};
+struct BuildLeaf {
+  BuildItem item;
+  uint32_t* triangles;
+};
+
+void* CreateNode(RTCThreadLocalAllocator alloc, unsigned int children, void*) {
+  void* mem = rtcThreadLocalAlloc(alloc, sizeof(BuildNode), alignof(BuildNode));
+  return new (mem) BuildNode{{false, children}, {}};
+}
+
+void SetNodeChildren(void* node, void** children, unsigned int count, void*) {
+  std::copy(children, children + count, static_cast<BuildNode*>(node)->child);
+}
+
+// The boxes are recomputed from the vertices when the tree is copied, so
+// they are exact whatever the builder did with them.
+void SetNodeBounds(void*, const RTCBounds**, unsigned int, void*) {}
+
+void* CreateLeaf(RTCThreadLocalAllocator alloc, const RTCBuildPrimitive* prims, size_t n, void*) {
+  void* mem = rtcThreadLocalAlloc(alloc, sizeof(BuildLeaf), alignof(BuildLeaf));
+  auto* ids = static_cast<uint32_t*>(rtcThreadLocalAlloc(alloc, n * sizeof(uint32_t), 4));
+  for (size_t i = 0; i < n; ++i) ids[i] = prims[i].primID;
+  return new (mem) BuildLeaf{{true, static_cast<uint32_t>(n)}, ids};
+}
+
+struct Box {
+  Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::infinity());
+  Eigen::Vector3f hi = Eigen::Vector3f::Constant(-std::numeric_limits<float>::infinity());
+  void Extend(const Eigen::Vector3f& p) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  void Extend(const Box& b) {
+    lo = lo.cwiseMin(b.lo);
+    hi = hi.cwiseMax(b.hi);
+  }
+};
+
+struct RtcBvh {
+  RTCBVH bvh;
+  ~RtcBvh() { rtcReleaseBVH(bvh); }
+};
+
+// The extra slack for the leaf's float copies of n and m_k: each component
+// is off by at most 2^-24 of itself, so a dot product with p - v by at most
+// 2^-24 |p - v|_1. 2e-7 is more than three times that.
+constexpr double kFloatStorageSlack = 2e-7;
+
+float RoundUp(double v) {
+  const float f = static_cast<float>(v);
+  return static_cast<double>(f) >= v ? f : std::nextafter(f, INFINITY);
+}
+
+}  // namespace
+
+// Copies Embree's tree into nodes and leaf blocks, depth first, so a
+// subtree's nodes and blocks lie together in memory.
+class WideBvhBuilder {
+ public:
+  WideBvhBuilder(WideBvh& out, const TriangleMesh& mesh, const std::vector<Eigen::Vector3d>& n)
+      : out_(out), mesh_(mesh), normals_(n) {}
+
+  absl::Status CopyRoot(const BuildItem* root) {
+    out_.nodes_.emplace_back();
+    if (root->leaf) {  // a mesh of a few triangles: one node with one leaf
+      out_.nodes_[0] = EmptyNode();
+      out_.nodes_[0].count = 1;
+      out_.stats_.depth = 1;
+      return AddChild(0, 0, root, 1);
+    }
+    return CopyNode(0, reinterpret_cast<const BuildNode*>(root), 1, nullptr);
+  }
+
+ private:
+  static wide::Node EmptyNode() {
+    wide::Node node;
+    std::memset(&node, 0, sizeof node);
+    std::fill(&node.lo[0][0], &node.lo[0][0] + 3 * wide::kWidth, INFINITY);
+    std::fill(&node.hi[0][0], &node.hi[0][0] + 3 * wide::kWidth, -INFINITY);
+    return node;
+  }
+
+  absl::Status CopyNode(uint32_t index, const BuildNode* node, int depth, Box* box) {
+    out_.nodes_[index] = EmptyNode();
+    out_.stats_.depth = std::max(out_.stats_.depth, depth);
+    Box all;
+    for (uint32_t i = 0; i < node->item.count; ++i) {
+      auto st = AddChild(index, i, static_cast<const BuildItem*>(node->child[i]), depth + 1);
+      if (!st.ok()) return st;
+      for (int a = 0; a < 3; ++a) {
+        all.lo[a] = std::min(all.lo[a], out_.nodes_[index].lo[a][i]);
+        all.hi[a] = std::max(all.hi[a], out_.nodes_[index].hi[a][i]);
+      }
+    }
+    out_.nodes_[index].count = node->item.count;
+    if (box) *box = all;
+    return absl::OkStatus();
+  }
+
+  absl::Status AddChild(uint32_t parent, uint32_t slot, const BuildItem* item, int depth) {
+    Box box;
+    if (item->leaf) {
+      const auto& leaf = *reinterpret_cast<const BuildLeaf*>(item);
+      if (leaf.item.count == 0 || leaf.item.count > 255)
+        return absl::InternalError(
+            absl::StrCat("wide BVH: a leaf of ", leaf.item.count, " triangles"));
+      out_.nodes_[parent].child[slot] = slots_;
+      out_.nodes_[parent].leaf_triangles[slot] = static_cast<uint8_t>(leaf.item.count);
+      AddLeaf(leaf, box);
+    } else {
+      const auto index = static_cast<uint32_t>(out_.nodes_.size());
+      out_.nodes_.emplace_back();
+      auto st = CopyNode(index, reinterpret_cast<const BuildNode*>(item), depth, &box);
+      if (!st.ok()) return st;
+      out_.nodes_[parent].child[slot] = index;
+      out_.nodes_[parent].leaf_triangles[slot] = 0;
+    }
+    for (int a = 0; a < 3; ++a) {
+      out_.nodes_[parent].lo[a][slot] = box.lo[a];
+      out_.nodes_[parent].hi[a][slot] = box.hi[a];
+    }
+    return absl::OkStatus();
+  }
+
+  // Triangles go to consecutive lanes: a leaf may start inside a block and
+  // end in the next, so no lane is left empty between leaves.
+  void AddLeaf(const BuildLeaf& leaf, Box& box) {
+    for (uint32_t i = 0; i < leaf.item.count; ++i) {
+      if (slots_ % wide::kLeafWidth == 0) out_.blocks_.push_back(EmptyLeafBlock());
+      const uint32_t t = leaf.triangles[i];
+      const Triangle& tri = mesh_.triangles[t];
+      const auto& v = mesh_.vertices;
+      FillLeafLane(out_.blocks_.back(), static_cast<int>(slots_++ % wide::kLeafWidth), t, v[tri[0]],
+                   v[tri[1]], v[tri[2]], normals_[t]);
+      for (int k = 0; k < 3; ++k) box.Extend(v[tri[k]]);
+    }
+  }
+
+  WideBvh& out_;
+  const TriangleMesh& mesh_;
+  const std::vector<Eigen::Vector3d>& normals_;
+  uint32_t slots_ = 0;  // leaf lanes filled so far
+};
+
+bool SearchIsaSupported(SearchIsa isa) {
+  switch (isa) {
+    case SearchIsa::kAvx2:
+      return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    case SearchIsa::kSse2:
+    case SearchIsa::kAuto:
+      break;
+  }
+  return true;
+}
+
+SearchIsa ResolveSearchIsa(SearchIsa isa) {
+  if (isa != SearchIsa::kAuto) return isa;
+  return SearchIsaSupported(SearchIsa::kAvx2) ? SearchIsa::kAvx2 : SearchIsa::kSse2;
+}
+
+const char* SearchIsaName(SearchIsa isa) {
+  return ResolveSearchIsa(isa) == SearchIsa::kAvx2 ? "avx2" : "sse2";
+}
+
+absl::StatusOr<WideBvh> WideBvh::Build(RTCDevice device, const TriangleMesh& mesh,
+                                       const std::vector<Eigen::Vector3d>& face_normals,
+                                       RTCBuildQuality quality, SearchIsa isa) {
+  if (!SearchIsaSupported(isa))
+    return absl::InvalidArgumentError(
+        absl::StrCat("mesh index: this CPU cannot run the ", SearchIsaName(isa), " search"));
+  WideBvh out;
+  out.isa_ = ResolveSearchIsa(isa);
+  out.search_ = out.isa_ == SearchIsa::kAvx2 ? &wide::avx2::Search : &wide::sse2::Search;
+  const std::size_t n = mesh.triangles.size();
+  if (n == 0) {
+    out.nodes_.push_back(wide::Node{});
+    return out;
+  }
+  std::vector<RTCBuildPrimitive> prims(n);
+  for (std::size_t t = 0; t < n; ++t) {
+    Box box;
+    for (int k = 0; k < 3; ++k) box.Extend(mesh.vertices[mesh.triangles[t][k]]);
+    prims[t] = RTCBuildPrimitive{box.lo.x(), box.lo.y(), box.lo.z(), 0,
+                                 box.hi.x(), box.hi.y(), box.hi.z(), static_cast<unsigned>(t)};
+  }
+  RtcBvh bvh{rtcNewBVH(device)};
+  if (!bvh.bvh) return absl::InternalError("mesh index: Embree could not create a BVH");
+  RTCBuildArguments args = rtcDefaultBuildArguments();
+  args.byteSize = sizeof(args);
+  args.buildQuality = quality;
+  args.maxBranchingFactor = wide::kWidth;
+  args.maxDepth = wide::kMaxDepth;
+  args.sahBlockSize = wide::kLeafWidth;  // a leaf of 4 costs as much as one of 1
+  args.minLeafSize = 1;
+  args.maxLeafSize = wide::kLeafWidth;
+  args.traversalCost = 1.0f;
+  args.intersectionCost = 1.0f;
+  args.bvh = bvh.bvh;
+  args.primitives = prims.data();
+  args.primitiveCount = n;
+  args.primitiveArrayCapacity = n;
+  args.createNode = &CreateNode;
+  args.setNodeChildren = &SetNodeChildren;
+  args.setNodeBounds = &SetNodeBounds;
+  args.createLeaf = &CreateLeaf;
+  const auto* root = static_cast<const BuildItem*>(rtcBuildBVH(&args));
+  if (!root) return absl::InternalError("mesh index: Embree's BVH build failed");
+  WideBvhBuilder builder(out, mesh, face_normals);
+  if (auto st = builder.CopyRoot(root); !st.ok()) return st;
+  out.nodes_.shrink_to_fit();
+  out.blocks_.shrink_to_fit();
+  out.stats_.nodes = out.nodes_.size();
+  out.stats_.leaf_blocks = out.blocks_.size();
+  return out;
+}
+
+std::size_t WideBvh::memory_bytes() const {
+  return nodes_.capacity() * sizeof(wide::Node) + blocks_.capacity() * sizeof(wide::LeafBlock);
+}
+
+wide::LeafBlock EmptyLeafBlock() {
+  wide::LeafBlock block;
+  std::memset(&block, 0, sizeof block);
+  std::fill(block.triangle, block.triangle + wide::kLeafWidth, UINT32_MAX);
+  return block;
+}
+
+void FillLeafLane(wide::LeafBlock& block, int lane, uint32_t t, const Eigen::Vector3f& a,
+                  const Eigen::Vector3f& b, const Eigen::Vector3f& c, const Eigen::Vector3d& n) {
+  const PrismBound bound = MakePrismBound(a.cast<double>(), b.cast<double>(), c.cast<double>(), n);
+  const Eigen::Vector3f* v[3] = {&a, &b, &c};
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int k = 0; k < 3; ++k) {
+      block.vertex[k][axis][lane] = (*v[k])[axis];
+      block.edge[k][axis][lane] = static_cast<float>(bound.edge[k][axis]);
+    }
+    block.normal[axis][lane] = static_cast<float>(n[axis]);
+  }
+  block.slack[lane] = RoundUp(bound.slack + kFloatStorageSlack);
+  block.triangle[lane] = t;
+  block.shape[lane] =
+      static_cast<uint8_t>(ClassifyTriangle(a.cast<double>(), b.cast<double>(), c.cast<double>()));
+}
+
+void LeafBounds2(SearchIsa isa, const wide::LeafBlock& block, const Eigen::Vector3d& p,
+                 double out[wide::kLeafWidth]) {
+  const double q[3] = {p.x(), p.y(), p.z()};
+  if (ResolveSearchIsa(isa) == SearchIsa::kAvx2 && SearchIsaSupported(SearchIsa::kAvx2))
+    wide::avx2::BlockBounds2(block, q, out);
+  else
+    wide::sse2::BlockBounds2(block, q, out);
+}
+
+}  // namespace surfinspect

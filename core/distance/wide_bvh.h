@@ -1,0 +1,76 @@
+// The mesh index's BVH: built by Embree (rtcBuildBVH, binned SAH or Morton,
+// 8 children per node, leaves of at most 4 triangles) and copied into our
+// own flat layout (core/distance/wide_bvh_layout.h), which a nearest-first
+// search walks 8 boxes and 4 triangle bounds at a time
+// (core/distance/wide_bvh_search.cpp). The search only culls: every
+// triangle it cannot rule out is handed to the caller's exact kernel, so
+// the answer is the brute-force answer whatever the instruction set.
+//
+// Instruction sets: the search is compiled for SSE2 (any x86-64) and for
+// AVX2 + FMA; kAuto takes AVX2 when the CPU and the OS support it
+// (__builtin_cpu_supports checks both). A 512-bit path would need 16-wide
+// nodes; the AVX2 code is what runs on an AVX-512 machine.
+#pragma once
+
+#include <embree3/rtcore.h>
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/distance/wide_bvh_layout.h"
+#include "core/types/triangle_mesh.h"
+
+namespace surfinspect {
+
+// "sse2" or "avx2"; kAuto resolves first.
+const char* SearchIsaName(SearchIsa isa);
+// kAuto as it resolves on this machine.
+SearchIsa ResolveSearchIsa(SearchIsa isa);
+bool SearchIsaSupported(SearchIsa isa);
+
+struct WideBvhStats {
+  std::size_t nodes = 0;
+  std::size_t leaf_blocks = 0;
+  int depth = 0;  // levels of nodes, the root's included
+};
+
+class WideBvh {
+ public:
+  // `face_normals` are the unit normals per triangle (0 for a degenerate
+  // one). `quality` is Embree's: LOW builds by Morton codes, MEDIUM and
+  // HIGH by binned SAH. Fails with Embree's error or InvalidArgument for an
+  // ISA this machine lacks. Run inside a TBB arena to bound the threads.
+  static absl::StatusOr<WideBvh> Build(RTCDevice device, const TriangleMesh& mesh,
+                                       const std::vector<Eigen::Vector3d>& face_normals,
+                                       RTCBuildQuality quality, SearchIsa isa);
+
+  void Search(wide::Query& query) const { search_(view(), query); }
+  wide::View view() const { return {nodes_.data(), blocks_.data()}; }
+  SearchIsa isa() const { return isa_; }
+  const WideBvhStats& stats() const { return stats_; }
+  std::size_t memory_bytes() const;
+
+ private:
+  std::vector<wide::Node> nodes_;
+  std::vector<wide::LeafBlock> blocks_;
+  SearchIsa isa_ = SearchIsa::kSse2;
+  void (*search_)(const wide::View&, wide::Query&) = &wide::sse2::Search;
+  WideBvhStats stats_;
+  friend class WideBvhBuilder;
+};
+
+// Puts triangle `t` (vertices a, b, c, unit normal n or 0) in a block's
+// lane: the floats the leaf bound reads. Unused lanes keep triangle
+// UINT32_MAX. Exposed for the bound's tests.
+void FillLeafLane(wide::LeafBlock& block, int lane, uint32_t t, const Eigen::Vector3f& a,
+                  const Eigen::Vector3f& b, const Eigen::Vector3f& c, const Eigen::Vector3d& n);
+// A block with every lane unused.
+wide::LeafBlock EmptyLeafBlock();
+// The leaf bound of the given ISA (the tests compare them); SSE2 when this
+// machine lacks the ISA.
+void LeafBounds2(SearchIsa isa, const wide::LeafBlock& block, const Eigen::Vector3d& p,
+                 double out[wide::kLeafWidth]);
+
+}  // namespace surfinspect

@@ -1,0 +1,236 @@
+// The wide BVH's nearest-first search (core/distance/wide_bvh.h), compiled
+// once per instruction set: SURFINSPECT_WIDE_ISA names the namespace, and
+// the build adds that set's flags (-mavx2 -mfma for avx2, none for sse2)
+// and -ffp-contract=off, so no multiply-add is fused differently in one
+// set than in another. The code is written in GCC vector extensions, so
+// the same operations in the same order run 8 floats or 4 doubles wide in
+// one AVX2 register or in two SSE2 registers: every lane computes the same
+// IEEE values in both.
+//
+// Boxes (float): the gap to a box along an axis is max(lo - p, p - hi, 0)
+// with p rounded to float, squared and summed in float. Against the exact
+// distance D from the double point to the box, the computed value d2'
+// satisfies sqrt(d2') <= (D + sqrt(3) 2^-24 s)(1 + 3 2^-24), s the largest
+// |coordinate| of p (rounding p, then four float operations per lane). A
+// box is culled only when d2' exceeds the search radius squared, and the
+// caller pads that radius to best (1 + 1e-6) + 1e-6 s + 1e-9 mm, more than
+// ten times the float error, so a culled box holds no triangle at or
+// below the best distance: the true minimiser and every exact tie are
+// always reached.
+//
+// Leaves (double): the prism bound of core/distance/prism_bound.h, four
+// triangles at a time, with the stored float normals' rounding inside the
+// slack. Triangles whose bound exceeds the best squared distance go no
+// further; the rest are offered to the exact kernel.
+#include <immintrin.h>  // gnu_inline intrinsics only: nothing out of line is emitted
+
+#include <cstdint>
+#include <cstring>
+
+#include "core/distance/wide_bvh_layout.h"
+
+#ifndef SURFINSPECT_WIDE_ISA
+#error "compiled once per instruction set, with SURFINSPECT_WIDE_ISA naming it"
+#endif
+
+namespace surfinspect::wide::SURFINSPECT_WIDE_ISA {
+namespace {
+
+// Inlined into the search, so the vectors stay in registers.
+#define SURFINSPECT_INLINE inline __attribute__((always_inline))
+
+typedef float F8 __attribute__((vector_size(32)));
+typedef float F4 __attribute__((vector_size(16)));
+typedef double D4 __attribute__((vector_size(32)));
+typedef int64_t L4 __attribute__((vector_size(32)));
+
+// Arithmetic is written with the vector operators; what GCC would lower
+// lane by lane on SSE2 (comparisons, max) goes through these, which use the
+// same instruction semantics in both sets (maxps / maxpd, cmpleps / cmplepd).
+#ifdef __AVX2__
+SURFINSPECT_INLINE F8 Max(F8 a, F8 b) {
+  return reinterpret_cast<F8>(
+      _mm256_max_ps(reinterpret_cast<__m256>(a), reinterpret_cast<__m256>(b)));
+}
+SURFINSPECT_INLINE D4 Max(D4 a, D4 b) {
+  return reinterpret_cast<D4>(
+      _mm256_max_pd(reinterpret_cast<__m256d>(a), reinterpret_cast<__m256d>(b)));
+}
+// Bit i set when lane i of v is <= limit.
+SURFINSPECT_INLINE uint32_t LessEqualMask(F8 v, float limit) {
+  return static_cast<uint32_t>(_mm256_movemask_ps(
+      _mm256_cmp_ps(reinterpret_cast<__m256>(v), _mm256_set1_ps(limit), _CMP_LE_OQ)));
+}
+SURFINSPECT_INLINE uint32_t LessEqualMask(D4 v, double limit) {
+  return static_cast<uint32_t>(_mm256_movemask_pd(
+      _mm256_cmp_pd(reinterpret_cast<__m256d>(v), _mm256_set1_pd(limit), _CMP_LE_OQ)));
+}
+SURFINSPECT_INLINE D4 LoadD4(const float* p) {
+  return reinterpret_cast<D4>(_mm256_cvtps_pd(_mm_load_ps(p)));
+}
+#else
+template <class V, class H>
+SURFINSPECT_INLINE void Split(V v, H half[2]) {
+  std::memcpy(half, &v, sizeof v);
+}
+template <class V, class H>
+SURFINSPECT_INLINE V Join(const H half[2]) {
+  V v;
+  std::memcpy(&v, half, sizeof v);
+  return v;
+}
+// op(a, b) on each 128-bit half.
+template <class H, class V, class Op>
+SURFINSPECT_INLINE V PerHalf(V a, V b, Op op) {
+  H x[2], y[2], m[2];
+  Split(a, x);
+  Split(b, y);
+  for (int i = 0; i < 2; ++i) m[i] = op(x[i], y[i]);
+  return Join<V>(m);
+}
+SURFINSPECT_INLINE F8 Max(F8 a, F8 b) {
+  return PerHalf<__m128>(a, b, [](__m128 x, __m128 y) { return _mm_max_ps(x, y); });
+}
+SURFINSPECT_INLINE D4 Max(D4 a, D4 b) {
+  return PerHalf<__m128d>(a, b, [](__m128d x, __m128d y) { return _mm_max_pd(x, y); });
+}
+SURFINSPECT_INLINE uint32_t LessEqualMask(F8 v, float limit) {
+  __m128 x[2];
+  Split(v, x);
+  const __m128 l = _mm_set1_ps(limit);
+  return static_cast<uint32_t>(_mm_movemask_ps(_mm_cmple_ps(x[0], l)) |
+                               (_mm_movemask_ps(_mm_cmple_ps(x[1], l)) << 4));
+}
+SURFINSPECT_INLINE uint32_t LessEqualMask(D4 v, double limit) {
+  __m128d x[2];
+  Split(v, x);
+  const __m128d l = _mm_set1_pd(limit);
+  return static_cast<uint32_t>(_mm_movemask_pd(_mm_cmple_pd(x[0], l)) |
+                               (_mm_movemask_pd(_mm_cmple_pd(x[1], l)) << 2));
+}
+SURFINSPECT_INLINE D4 LoadD4(const float* p) {
+  const __m128 v = _mm_load_ps(p);
+  const __m128d half[2] = {_mm_cvtps_pd(v), _mm_cvtps_pd(_mm_movehl_ps(v, v))};
+  return Join<D4>(half);
+}
+#endif
+
+SURFINSPECT_INLINE F8 LoadF8(const float* p) {
+  F8 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+SURFINSPECT_INLINE D4 Abs(D4 v) {
+  return reinterpret_cast<D4>(reinterpret_cast<L4>(v) & (L4{} + INT64_MAX));
+}
+
+// The float squared distance from the point to each of the node's boxes.
+SURFINSPECT_INLINE F8 BoxDistance2(const Node& node, const F8 p[3]) {
+  F8 d2 = {};
+  for (int axis = 0; axis < 3; ++axis) {
+    const F8 below = LoadF8(node.lo[axis]) - p[axis];
+    const F8 above = p[axis] - LoadF8(node.hi[axis]);
+    const F8 gap = Max(Max(below, above), F8{});
+    d2 += gap * gap;
+  }
+  return d2;
+}
+
+// below^2 + out^2 per lane (prism_bound.h), in double.
+SURFINSPECT_INLINE D4 Bounds2(const LeafBlock& block, const double p[3]) {
+  D4 d[3][3];  // p - vertex k
+  D4 l1[3];    // |p - vertex k|_1
+  for (int k = 0; k < 3; ++k) {
+    for (int axis = 0; axis < 3; ++axis) d[k][axis] = p[axis] - LoadD4(block.vertex[k][axis]);
+    l1[k] = Abs(d[k][0]) + Abs(d[k][1]) + Abs(d[k][2]);
+  }
+  const D4 slack = LoadD4(block.slack);
+  const D4 below = Max(Abs(LoadD4(block.normal[0]) * d[0][0] + LoadD4(block.normal[1]) * d[0][1] +
+                           LoadD4(block.normal[2]) * d[0][2]) -
+                           slack * l1[0],
+                       D4{});
+  D4 out = {};
+  for (int k = 0; k < 3; ++k)
+    out = Max(LoadD4(block.edge[k][0]) * d[k][0] + LoadD4(block.edge[k][1]) * d[k][1] +
+                  LoadD4(block.edge[k][2]) * d[k][2] - slack * l1[k],
+              out);
+  return below * below + out * out;
+}
+
+// The leaf of lanes [first, first + count), one block at a time.
+SURFINSPECT_INLINE void VisitLeaf(const View& view, uint32_t first, uint32_t count, Query& q) {
+  const uint32_t end = first + count;
+  for (uint32_t b = first / kLeafWidth; b * kLeafWidth < end; ++b) {
+    const LeafBlock& block = view.blocks[b];
+    const uint32_t base = b * kLeafWidth;
+    const uint32_t from = first > base ? first - base : 0;
+    const uint32_t to = end - base < kLeafWidth ? end - base : kLeafWidth;
+    const uint32_t lanes = ((1u << to) - 1) & ~((1u << from) - 1);
+    const D4 bound2 = Bounds2(block, q.p);
+    uint32_t mask = LessEqualMask(bound2, q.best_d2) & lanes;
+    while (mask != 0) {
+      const int lane = __builtin_ctz(mask);
+      mask &= mask - 1;
+      // An earlier lane may have lowered the best distance since.
+      if (bound2[lane] <= q.best_d2) q.offer(q, block, lane);
+    }
+  }
+}
+
+struct Entry {
+  float d2;
+  uint32_t child;
+  uint32_t leaf_triangles;  // 0 for a node
+};
+
+// The node's children within the radius, nearest first.
+SURFINSPECT_INLINE int LiveChildren(const Node& node, const F8 p[3], float radius2,
+                                    Entry live[kWidth]) {
+  const F8 d2 = BoxDistance2(node, p);
+  uint32_t mask = LessEqualMask(d2, radius2) & ((1u << node.count) - 1);
+  int n = 0;
+  while (mask != 0) {
+    const int i = __builtin_ctz(mask);
+    mask &= mask - 1;
+    const Entry e{d2[i], node.child[i], node.leaf_triangles[i]};
+    int j = n++;
+    for (; j > 0 && live[j - 1].d2 > e.d2; --j) live[j] = live[j - 1];
+    live[j] = e;
+  }
+  return n;
+}
+
+}  // namespace
+
+void Search(const View& view, Query& q) {
+  const F8 p[3] = {F8{} + q.pf[0], F8{} + q.pf[1], F8{} + q.pf[2]};
+  Entry stack[kStackSize];
+  int top = 0;
+  Entry next{0.f, 0, 0};  // the root
+  for (;;) {
+    if (next.d2 <= q.box_radius2) {
+      if (next.leaf_triangles != 0) {
+        VisitLeaf(view, next.child, next.leaf_triangles, q);
+      } else {
+        Entry live[kWidth];
+        const int n = LiveChildren(view.nodes[next.child], p, q.box_radius2, live);
+        // The nearest child is visited next; the others wait, farthest deepest.
+        for (int j = n - 1; j >= 1; --j) stack[top++] = live[j];
+        if (n > 0) {
+          next = live[0];
+          continue;
+        }
+      }
+    }
+    if (top == 0) return;
+    next = stack[--top];
+  }
+}
+
+void BlockBounds2(const LeafBlock& block, const double p[3], double out[kLeafWidth]) {
+  const D4 bound2 = Bounds2(block, p);
+  for (int lane = 0; lane < kLeafWidth; ++lane) out[lane] = bound2[lane];
+}
+
+}  // namespace surfinspect::wide::SURFINSPECT_WIDE_ISA
