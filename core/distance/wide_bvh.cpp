@@ -107,6 +107,9 @@ class WideBvhBuilder {
 
   absl::Status CopyNode(uint32_t index, const BuildNode* node, int depth, Box* box) {
     out_.nodes_[index] = EmptyNode();
+    // The search's stack holds 7 entries per level of kMaxDepth.
+    if (depth > wide::kMaxDepth)
+      return absl::InternalError(absl::StrCat("wide BVH: deeper than ", wide::kMaxDepth));
     out_.stats_.depth = std::max(out_.stats_.depth, depth);
     Box all;
     for (uint32_t i = 0; i < node->item.count; ++i) {
