@@ -28,12 +28,9 @@ float SearchRadius(double distance_mm, double coordinate_scale) {
   return std::nextafter(static_cast<float>(padded), INFINITY);
 }
 
-// The radius squared, rounded up to a float.
-float SearchRadius2(float radius) {
-  const double r2 = static_cast<double>(radius) * radius;  // exact: 48 bits
-  const float f = static_cast<float>(r2);
-  return static_cast<double>(f) >= r2 ? f : std::nextafter(f, INFINITY);
-}
+// The radius squared, rounded up to a float (the double product is exact:
+// 48 bits).
+float SearchRadius2(float radius) { return RoundUpToFloat(static_cast<double>(radius) * radius); }
 
 struct QueryState {
   Eigen::Vector3d p;

@@ -71,12 +71,12 @@ struct RtcBvh {
 // 2^-24 |p - v|_1. 2e-7 is more than three times that.
 constexpr double kFloatStorageSlack = 2e-7;
 
-float RoundUp(double v) {
+}  // namespace
+
+float RoundUpToFloat(double v) {
   const float f = static_cast<float>(v);
   return static_cast<double>(f) >= v ? f : std::nextafter(f, INFINITY);
 }
-
-}  // namespace
 
 // Copies Embree's tree into nodes and leaf blocks, depth first, so a
 // subtree's nodes and blocks lie together in memory.
@@ -91,7 +91,8 @@ class WideBvhBuilder {
       out_.nodes_[0] = EmptyNode();
       out_.nodes_[0].count = 1;
       out_.stats_.depth = 1;
-      return AddChild(0, 0, root, 1);
+      Box unused;
+      return AddChild(0, 0, root, 1, unused);
     }
     return CopyNode(0, reinterpret_cast<const BuildNode*>(root), 1, nullptr);
   }
@@ -113,19 +114,17 @@ class WideBvhBuilder {
     out_.stats_.depth = std::max(out_.stats_.depth, depth);
     Box all;
     for (uint32_t i = 0; i < node->item.count; ++i) {
-      auto st = AddChild(index, i, static_cast<const BuildItem*>(node->child[i]), depth + 1);
+      auto st = AddChild(index, i, static_cast<const BuildItem*>(node->child[i]), depth + 1, all);
       if (!st.ok()) return st;
-      for (int a = 0; a < 3; ++a) {
-        all.lo[a] = std::min(all.lo[a], out_.nodes_[index].lo[a][i]);
-        all.hi[a] = std::max(all.hi[a], out_.nodes_[index].hi[a][i]);
-      }
     }
     out_.nodes_[index].count = node->item.count;
     if (box) *box = all;
     return absl::OkStatus();
   }
 
-  absl::Status AddChild(uint32_t parent, uint32_t slot, const BuildItem* item, int depth) {
+  // Copies the child into the parent's slot and extends `parent_box` by its box.
+  absl::Status AddChild(uint32_t parent, uint32_t slot, const BuildItem* item, int depth,
+                        Box& parent_box) {
     Box box;
     if (item->leaf) {
       const auto& leaf = *reinterpret_cast<const BuildLeaf*>(item);
@@ -147,6 +146,7 @@ class WideBvhBuilder {
       out_.nodes_[parent].lo[a][slot] = box.lo[a];
       out_.nodes_[parent].hi[a][slot] = box.hi[a];
     }
+    parent_box.Extend(box);
     return absl::OkStatus();
   }
 
@@ -264,7 +264,7 @@ void FillLeafLane(wide::LeafBlock& block, int lane, uint32_t t, const Eigen::Vec
     }
     block.normal[axis][lane] = static_cast<float>(n[axis]);
   }
-  block.slack[lane] = RoundUp(bound.slack + kFloatStorageSlack);
+  block.slack[lane] = RoundUpToFloat(bound.slack + kFloatStorageSlack);
   block.triangle[lane] = t;
   block.shape[lane] =
       static_cast<uint8_t>(ClassifyTriangle(a.cast<double>(), b.cast<double>(), c.cast<double>()));

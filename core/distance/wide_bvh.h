@@ -66,6 +66,8 @@ class WideBvh {
 // UINT32_MAX. Exposed for the bound's tests.
 void FillLeafLane(wide::LeafBlock& block, int lane, uint32_t t, const Eigen::Vector3f& a,
                   const Eigen::Vector3f& b, const Eigen::Vector3f& c, const Eigen::Vector3d& n);
+// The smallest float >= v.
+float RoundUpToFloat(double v);
 // A block with every lane unused.
 wide::LeafBlock EmptyLeafBlock();
 // The leaf bound of the given ISA (the tests compare them); SSE2 when this

@@ -40,7 +40,6 @@ namespace {
 #define SURFINSPECT_INLINE inline __attribute__((always_inline))
 
 typedef float F8 __attribute__((vector_size(32)));
-typedef float F4 __attribute__((vector_size(16)));
 typedef double D4 __attribute__((vector_size(32)));
 typedef int64_t L4 __attribute__((vector_size(32)));
 
