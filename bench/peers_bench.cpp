@@ -12,6 +12,7 @@
 
 #include "bench/peers/calibration_rows.h"
 #include "bench/peers/clustering_rows.h"
+#include "bench/peers/command_rows.h"
 #include "bench/peers/distance_rows.h"
 #include "bench/peers/report.h"
 #include "bench/peers/service_rows.h"
@@ -49,6 +50,7 @@ int main(int argc, char** argv) {
   section("ICP calibration", [&] { AddCalibrationRows(rows); });
   section("scan simulator", [&] { AddSimulatorRow(rows); });
   section("service", [&] { AddServiceRows(rows); });
+  section("whole command", [&] { AddCommandRows(rows); });
   const double total =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
