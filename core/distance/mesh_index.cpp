@@ -25,7 +25,7 @@ namespace {
 float SearchRadius(double distance_mm, double coordinate_scale) {
   if (!(distance_mm < static_cast<double>(std::numeric_limits<float>::max()) / 2)) return INFINITY;
   const double padded = distance_mm * (1 + 1e-6) + 1e-6 * coordinate_scale + 1e-9;
-  return std::nextafter(static_cast<float>(padded), INFINITY);
+  return NextUp(static_cast<float>(padded));
 }
 
 // The radius squared, rounded up to a float (the double product is exact:
@@ -36,6 +36,7 @@ struct QueryState {
   Eigen::Vector3d p;
   const Eigen::Vector3f* vertices;
   const Triangle* triangles;
+  const TriangleShape* shapes;
   double coordinate_scale;
   uint32_t best_triangle = UINT32_MAX;
   PointTriangleResult best;
@@ -74,10 +75,10 @@ bool OfferLane(wide::Query& q, const wide::LeafBlock& block, int lane) {
 void OfferTriangle(wide::Query& q, uint32_t t) {
   auto& s = *static_cast<QueryState*>(q.context);
   const Triangle& tri = s.triangles[t];
-  Consider(
-      q, s, t,
-      ClosestPointOnTriangle(s.p, s.vertices[tri[0]].cast<double>(),
-                             s.vertices[tri[1]].cast<double>(), s.vertices[tri[2]].cast<double>()));
+  Consider(q, s, t,
+           ClosestPointOnTriangle(s.p, s.vertices[tri[0]].cast<double>(),
+                                  s.vertices[tri[1]].cast<double>(),
+                                  s.vertices[tri[2]].cast<double>(), s.shapes[t]));
 }
 
 RTCBuildQuality ToEmbree(BvhQuality q) {
@@ -123,7 +124,7 @@ absl::StatusOr<std::unique_ptr<MeshIndex>> MeshIndex::Build(TriangleMesh mesh,
   absl::StatusOr<WideBvh> bvh;
   arena.execute([&] {
     try {
-      bvh = WideBvh::Build((*device)->get(), index->mesh_, index->face_normal_,
+      bvh = WideBvh::Build((*device)->get(), index->mesh_, index->face_normal_, index->shape_,
                            ToEmbree(settings.build_quality), settings.search_isa);
     } catch (const std::bad_alloc&) {
       bvh = absl::ResourceExhaustedError(
@@ -165,8 +166,12 @@ void MeshIndex::ComputePseudonormals() {
   }
 
   face_normal_.assign(tris.size(), Eigen::Vector3d::Zero());
+  shape_.resize(tris.size());
   for (std::size_t t = 0; t < tris.size(); ++t) {
-    if (mesh_.IsDegenerate(t)) {
+    // The kernel's degeneracy test is TriangleMesh::IsDegenerate's.
+    shape_[t] = ClassifyTriangle(verts[tris[t][0]].cast<double>(), verts[tris[t][1]].cast<double>(),
+                                 verts[tris[t][2]].cast<double>());
+    if (shape_[t] == TriangleShape::kDegenerate) {
       ++info_.degenerate_triangles;
       continue;  // a zero normal: contributes nothing to its neighbours' sums
     }
@@ -231,6 +236,7 @@ ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_dis
   QueryState s{p_in_mesh,
                mesh_.vertices.data(),
                mesh_.triangles.data(),
+               shape_.data(),
                p_in_mesh.cwiseAbs().maxCoeff(),
                UINT32_MAX,
                {}};
@@ -267,7 +273,7 @@ ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_dis
 std::size_t MeshIndex::memory_bytes() const {
   return sizeof(*this) + mesh_.vertices.capacity() * sizeof(Eigen::Vector3f) +
          mesh_.triangles.capacity() * sizeof(Triangle) +
-         face_normal_.capacity() * sizeof(Eigen::Vector3d) +
+         face_normal_.capacity() * sizeof(Eigen::Vector3d) + shape_.capacity() +
          triangle_edges_.capacity() * sizeof(triangle_edges_[0]) +
          edge_normal_.capacity() * sizeof(Eigen::Vector3d) + weld_.capacity() * sizeof(uint32_t) +
          vertex_normal_.capacity() * sizeof(Eigen::Vector3d) + (bvh_ ? bvh_->memory_bytes() : 0);

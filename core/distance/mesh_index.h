@@ -109,6 +109,7 @@ class MeshIndex {
   TriangleMesh mesh_;
   MeshIndexInfo info_;
   std::vector<Eigen::Vector3d> face_normal_;             // per triangle, unit or 0
+  std::vector<TriangleShape> shape_;                     // per triangle, for the kernel
   std::vector<std::array<uint32_t, 3>> triangle_edges_;  // per triangle: edge ids of AB, BC, CA
   std::vector<Eigen::Vector3d> edge_normal_;             // per edge: sum of adjacent face normals
   std::vector<uint32_t> weld_;                           // vertex -> representative vertex

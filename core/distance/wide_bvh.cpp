@@ -73,17 +73,13 @@ constexpr double kFloatStorageSlack = 2e-7;
 
 }  // namespace
 
-float RoundUpToFloat(double v) {
-  const float f = static_cast<float>(v);
-  return static_cast<double>(f) >= v ? f : std::nextafter(f, INFINITY);
-}
-
 // Copies Embree's tree into nodes and leaf blocks, depth first, so a
 // subtree's nodes and blocks lie together in memory.
 class WideBvhBuilder {
  public:
-  WideBvhBuilder(WideBvh& out, const TriangleMesh& mesh, const std::vector<Eigen::Vector3d>& n)
-      : out_(out), mesh_(mesh), normals_(n) {}
+  WideBvhBuilder(WideBvh& out, const TriangleMesh& mesh, const std::vector<Eigen::Vector3d>& n,
+                 const std::vector<TriangleShape>& shapes)
+      : out_(out), mesh_(mesh), normals_(n), shapes_(shapes) {}
 
   absl::Status CopyRoot(const BuildItem* root) {
     out_.nodes_.emplace_back();
@@ -159,7 +155,7 @@ class WideBvhBuilder {
       const Triangle& tri = mesh_.triangles[t];
       const auto& v = mesh_.vertices;
       FillLeafLane(out_.blocks_.back(), static_cast<int>(slots_++ % wide::kLeafWidth), t, v[tri[0]],
-                   v[tri[1]], v[tri[2]], normals_[t]);
+                   v[tri[1]], v[tri[2]], normals_[t], shapes_[t]);
       for (int k = 0; k < 3; ++k) box.Extend(v[tri[k]]);
     }
   }
@@ -167,6 +163,7 @@ class WideBvhBuilder {
   WideBvh& out_;
   const TriangleMesh& mesh_;
   const std::vector<Eigen::Vector3d>& normals_;
+  const std::vector<TriangleShape>& shapes_;
   uint32_t slots_ = 0;  // leaf lanes filled so far
 };
 
@@ -192,6 +189,7 @@ const char* SearchIsaName(SearchIsa isa) {
 
 absl::StatusOr<WideBvh> WideBvh::Build(RTCDevice device, const TriangleMesh& mesh,
                                        const std::vector<Eigen::Vector3d>& face_normals,
+                                       const std::vector<TriangleShape>& shapes,
                                        RTCBuildQuality quality, SearchIsa isa) {
   if (!SearchIsaSupported(isa))
     return absl::InvalidArgumentError(
@@ -233,7 +231,7 @@ absl::StatusOr<WideBvh> WideBvh::Build(RTCDevice device, const TriangleMesh& mes
   args.createLeaf = &CreateLeaf;
   const auto* root = static_cast<const BuildItem*>(rtcBuildBVH(&args));
   if (!root) return absl::InternalError("mesh index: Embree's BVH build failed");
-  WideBvhBuilder builder(out, mesh, face_normals);
+  WideBvhBuilder builder(out, mesh, face_normals, shapes);
   if (auto st = builder.CopyRoot(root); !st.ok()) return st;
   out.nodes_.shrink_to_fit();
   out.blocks_.shrink_to_fit();
@@ -254,7 +252,8 @@ wide::LeafBlock EmptyLeafBlock() {
 }
 
 void FillLeafLane(wide::LeafBlock& block, int lane, uint32_t t, const Eigen::Vector3f& a,
-                  const Eigen::Vector3f& b, const Eigen::Vector3f& c, const Eigen::Vector3d& n) {
+                  const Eigen::Vector3f& b, const Eigen::Vector3f& c, const Eigen::Vector3d& n,
+                  TriangleShape shape) {
   const PrismBound bound = MakePrismBound(a.cast<double>(), b.cast<double>(), c.cast<double>(), n);
   const Eigen::Vector3f* v[3] = {&a, &b, &c};
   for (int axis = 0; axis < 3; ++axis) {
@@ -266,8 +265,7 @@ void FillLeafLane(wide::LeafBlock& block, int lane, uint32_t t, const Eigen::Vec
   }
   block.slack[lane] = RoundUpToFloat(bound.slack + kFloatStorageSlack);
   block.triangle[lane] = t;
-  block.shape[lane] =
-      static_cast<uint8_t>(ClassifyTriangle(a.cast<double>(), b.cast<double>(), c.cast<double>()));
+  block.shape[lane] = static_cast<uint8_t>(shape);
 }
 
 void LeafBounds2(SearchIsa isa, const wide::LeafBlock& block, const Eigen::Vector3d& p,

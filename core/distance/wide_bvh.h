@@ -15,10 +15,13 @@
 #include <embree3/rtcore.h>
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstddef>
+#include <cstring>
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "core/distance/point_triangle.h"
 #include "core/distance/wide_bvh_layout.h"
 #include "core/types/triangle_mesh.h"
 
@@ -39,11 +42,12 @@ struct WideBvhStats {
 class WideBvh {
  public:
   // `face_normals` are the unit normals per triangle (0 for a degenerate
-  // one). `quality` is Embree's: LOW builds by Morton codes, MEDIUM and
-  // HIGH by binned SAH. Fails with Embree's error or InvalidArgument for an
-  // ISA this machine lacks. Run inside a TBB arena to bound the threads.
+  // one), `shapes` their ClassifyTriangle. `quality` is Embree's: LOW builds by Morton codes,
+  // MEDIUM and HIGH by binned SAH. Fails with Embree's error or InvalidArgument for an ISA this
+  // machine lacks. Run inside a TBB arena to bound the threads.
   static absl::StatusOr<WideBvh> Build(RTCDevice device, const TriangleMesh& mesh,
                                        const std::vector<Eigen::Vector3d>& face_normals,
+                                       const std::vector<TriangleShape>& shapes,
                                        RTCBuildQuality quality, SearchIsa isa);
 
   void Search(wide::Query& query) const { search_(view(), query); }
@@ -61,13 +65,29 @@ class WideBvh {
   friend class WideBvhBuilder;
 };
 
-// Puts triangle `t` (vertices a, b, c, unit normal n or 0) in a block's
+// Puts triangle `t` (vertices a, b, c, unit normal n or 0, its kernel
+// shape) in a block's
 // lane: the floats the leaf bound reads. Unused lanes keep triangle
 // UINT32_MAX. Exposed for the bound's tests.
 void FillLeafLane(wide::LeafBlock& block, int lane, uint32_t t, const Eigen::Vector3f& a,
-                  const Eigen::Vector3f& b, const Eigen::Vector3f& c, const Eigen::Vector3d& n);
+                  const Eigen::Vector3f& b, const Eigen::Vector3f& c, const Eigen::Vector3d& n,
+                  TriangleShape shape);
+// std::nextafter(f, INFINITY) without the library call on the search's
+// path: for a finite f > 0 the next float up is the next bit pattern.
+inline float NextUp(float f) {
+  if (!(f > 0 && f < INFINITY)) return std::nextafter(f, INFINITY);
+  uint32_t bits;
+  std::memcpy(&bits, &f, sizeof bits);
+  ++bits;
+  std::memcpy(&f, &bits, sizeof f);
+  return f;
+}
+
 // The smallest float >= v.
-float RoundUpToFloat(double v);
+inline float RoundUpToFloat(double v) {
+  const float f = static_cast<float>(v);
+  return static_cast<double>(f) >= v ? f : NextUp(f);
+}
 // A block with every lane unused.
 wide::LeafBlock EmptyLeafBlock();
 // The leaf bound of the given ISA (the tests compare them); SSE2 when this

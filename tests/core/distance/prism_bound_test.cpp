@@ -19,7 +19,8 @@ using Eigen::Vector3f;
 double LeafBound2(const Vector3d& a, const Vector3d& b, const Vector3d& c, const Vector3d& n,
                   const Vector3d& p) {
   wide::LeafBlock block = EmptyLeafBlock();
-  FillLeafLane(block, 1, 7, a.cast<float>(), b.cast<float>(), c.cast<float>(), n);
+  FillLeafLane(block, 1, 7, a.cast<float>(), b.cast<float>(), c.cast<float>(), n,
+               ClassifyTriangle(a, b, c));
   double sse2[wide::kLeafWidth], avx2[wide::kLeafWidth];
   LeafBounds2(SearchIsa::kSse2, block, p, sse2);
   LeafBounds2(SearchIsa::kAvx2, block, p, avx2);
@@ -88,7 +89,7 @@ TEST(PrismBound, EachLaneOfABlockIsItsOwnTriangle) {
   EXPECT_EQ(block.triangle[3], UINT32_MAX);
   for (int lane = 0; lane < wide::kLeafWidth; ++lane)
     FillLeafLane(block, lane, lane, Vector3f(0, 0, lane), Vector3f(1, 0, lane),
-                 Vector3f(0, 1, lane), Vector3d(0, 0, 1));
+                 Vector3f(0, 1, lane), Vector3d(0, 0, 1), TriangleShape::kRegular);
   double out[wide::kLeafWidth];
   LeafBounds2(SearchIsa::kAuto, block, Vector3d(0.2, 0.2, 10), out);
   for (int lane = 0; lane < wide::kLeafWidth; ++lane)

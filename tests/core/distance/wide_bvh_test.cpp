@@ -8,6 +8,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <cstring>
+#include <limits>
 #include <random>
 
 #include "core/distance/embree_handles.h"
@@ -42,10 +44,18 @@ std::vector<Vector3d> Normals(const TriangleMesh& m) {
   return n;
 }
 
+std::vector<TriangleShape> Shapes(const TriangleMesh& m) {
+  std::vector<TriangleShape> s;
+  for (const auto& t : m.triangles)
+    s.push_back(ClassifyTriangle(m.vertices[t[0]].cast<double>(), m.vertices[t[1]].cast<double>(),
+                                 m.vertices[t[2]].cast<double>()));
+  return s;
+}
+
 WideBvh BuildOrDie(const TriangleMesh& m, RTCBuildQuality quality, SearchIsa isa) {
   auto device = EmbreeDevice::Create();
   EXPECT_TRUE(device.ok());
-  auto bvh = WideBvh::Build((*device)->get(), m, Normals(m), quality, isa);
+  auto bvh = WideBvh::Build((*device)->get(), m, Normals(m), Shapes(m), quality, isa);
   EXPECT_TRUE(bvh.ok()) << bvh.status();
   return *std::move(bvh);
 }
@@ -81,6 +91,11 @@ void CheckSubtree(const wide::View& v, const TriangleMesh& m, uint32_t node, int
         EXPECT_TRUE(inside(p)) << "triangle " << t << " outside its leaf box";
         for (int a = 0; a < 3; ++a) EXPECT_EQ(block.vertex[k][a][lane], p[a]);
       }
+      const auto& tri = m.triangles[t];
+      EXPECT_EQ(block.shape[lane],
+                static_cast<uint8_t>(ClassifyTriangle(m.vertices[tri[0]].cast<double>(),
+                                                      m.vertices[tri[1]].cast<double>(),
+                                                      m.vertices[tri[2]].cast<double>())));
     }
   }
 }
@@ -165,6 +180,45 @@ TEST(WideBvh, SearchFindsTheBruteForceMinimiserInEveryIsaAndPrunes) {
     // It culls: far fewer kernel calls than triangles.
     EXPECT_LT(offers, 300 * 60) << SearchIsaName(isa);
   }
+}
+
+// NextUp is std::nextafter(f, INFINITY), bit for bit, on the edge cases
+// and on random floats of every magnitude and sign.
+TEST(WideBvh, NextUpIsNextafterTowardsInfinity) {
+  std::vector<float> values = {0.f,
+                               -0.f,
+                               std::numeric_limits<float>::denorm_min(),
+                               std::numeric_limits<float>::min(),
+                               1.f,
+                               std::numeric_limits<float>::max(),
+                               INFINITY,
+                               -INFINITY,
+                               -1.f,
+                               -std::numeric_limits<float>::max(),
+                               NAN};
+  std::mt19937 rng(5);
+  for (int i = 0; i < 100000; ++i) {
+    const uint32_t bits = static_cast<uint32_t>(rng());
+    float f;
+    std::memcpy(&f, &bits, sizeof f);
+    values.push_back(f);
+  }
+  for (float f : values) {
+    const float want = std::nextafter(f, INFINITY), got = NextUp(f);
+    if (std::isnan(want)) {
+      EXPECT_TRUE(std::isnan(got));
+      continue;
+    }
+    uint32_t a, b;
+    std::memcpy(&a, &want, sizeof a);
+    std::memcpy(&b, &got, sizeof b);
+    ASSERT_EQ(a, b) << f;
+  }
+  // float(0.1) lies above 0.1, float(0.7) below 0.7.
+  EXPECT_EQ(RoundUpToFloat(0.1), static_cast<float>(0.1));
+  EXPECT_EQ(RoundUpToFloat(0.7), std::nextafter(static_cast<float>(0.7), INFINITY));
+  EXPECT_GE(static_cast<double>(RoundUpToFloat(0.7)), 0.7);
+  EXPECT_EQ(RoundUpToFloat(0.5), 0.5f);
 }
 
 }  // namespace
