@@ -115,26 +115,25 @@ inline void AddCommandRows(std::vector<Row>& rows) {
     rows.push_back({what, "failed to write the inputs", "", "", "", "", ""});
     return;
   }
-  const std::string ours_cmd = BinDir() + "/surfinspect errormap --cloud " + cloud + " --mesh " +
+  constexpr const char* kQuiet = " >/dev/null 2>&1";
+  const std::string ours_run = BinDir() + "/surfinspect errormap --cloud " + cloud + " --mesh " +
                                mesh + " --out " + dir.File("out.ply") + " --report " +
-                               dir.File("report.json") + " >/dev/null 2>&1";
-  const double ours = CommandSeconds(ours_cmd, 3);
+                               dir.File("report.json");
+  const double ours = CommandSeconds(ours_run + kQuiet, 3);
   const std::string script = dir.File("o3d.py");
   std::ofstream(script) << kOpen3dScript;
   const bool have_o3d = std::system("/usr/bin/python3 -c 'import open3d' >/dev/null 2>&1") == 0;
-  const std::string o3d_cmd =
-      "/usr/bin/python3 " + script + " " + cloud + " " + mesh + " >/dev/null 2>&1";
-  const double o3d = have_o3d ? CommandSeconds(o3d_cmd, 3) : NAN;
+  const std::string o3d_run = "/usr/bin/python3 " + script + " " + cloud + " " + mesh;
+  const double o3d = have_o3d ? CommandSeconds(o3d_run + kQuiet, 3) : NAN;
   std::string agreement = "—";
   if (have_o3d) {  // untimed runs: our CSV and Open3D's raw distances
-    const bool ran = std::system((ours_cmd + " --csv " + dir.File("out.csv")).c_str()) == 0 &&
-                     std::system(("/usr/bin/python3 " + script + " " + cloud + " " + mesh + " " +
-                                  dir.File("o3d.raw") + " >/dev/null 2>&1")
-                                     .c_str()) == 0;
+    const bool ran =
+        std::system((ours_run + " --csv " + dir.File("out.csv") + kQuiet).c_str()) == 0 &&
+        std::system((o3d_run + " " + dir.File("o3d.raw") + kQuiet).c_str()) == 0;
     const double diff =
         ran ? MaxDifference(dir.File("out.csv"), dir.File("o3d.raw"), points.size()) : NAN;
-    agreement =
-        std::isfinite(diff) ? Fmt("max abs(abs(ours) − Open3D) = %.1e mm", diff) : "comparison failed";
+    agreement = std::isfinite(diff) ? Fmt("max abs(abs(ours) − Open3D) = %.1e mm", diff)
+                                    : "comparison failed";
   }
   const std::string ours_cell = std::isfinite(ours) ? Time(ours) : "failed";
   rows.push_back({what, ours_cell,
@@ -146,7 +145,7 @@ inline void AddCommandRows(std::vector<Row>& rows) {
   const double cc = have_cc ? CommandSeconds(
                                   "QT_QPA_PLATFORM=offscreen CloudCompare -SILENT "
                                   "-AUTO_SAVE OFF -O " +
-                                      cloud + " -O " + mesh + " -C2M_DIST >/dev/null 2>&1",
+                                      cloud + " -O " + mesh + " -C2M_DIST" + kQuiet,
                                   1)
                             : NAN;
   rows.push_back({what, ours_cell, PeerCell(have_cc, cc, " (CloudCompare -C2M_DIST)"),
