@@ -1,5 +1,6 @@
 #include "core/distance/mesh_index.h"
 
+#include <tbb/parallel_invoke.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -114,7 +115,7 @@ absl::StatusOr<std::unique_ptr<MeshIndex>> MeshIndex::Build(TriangleMesh mesh,
   const auto start = std::chrono::steady_clock::now();
   std::unique_ptr<MeshIndex> index(new MeshIndex());
   index->mesh_ = std::move(mesh);
-  index->ComputePseudonormals();
+  index->ComputeFaceNormals();
   auto device = EmbreeDevice::Create();
   if (!device.ok()) return device.status();
   // Embree builds with TBB; an arena bounds the build's threads without a
@@ -124,11 +125,17 @@ absl::StatusOr<std::unique_ptr<MeshIndex>> MeshIndex::Build(TriangleMesh mesh,
   absl::StatusOr<WideBvh> bvh;
   arena.execute([&] {
     try {
-      bvh = WideBvh::Build((*device)->get(), index->mesh_, index->face_normal_, index->shape_,
-                           ToEmbree(settings.build_quality), settings.search_isa);
+      // The edge and vertex pseudonormals are serial work: they run beside
+      // Embree's parallel build instead of before it.
+      tbb::parallel_invoke(
+          [&] {
+            bvh = WideBvh::Build((*device)->get(), index->mesh_, index->face_normal_, index->shape_,
+                                 ToEmbree(settings.build_quality), settings.search_isa);
+          },
+          [&] { index->ComputeFeatureNormals(); });
     } catch (const std::bad_alloc&) {
       bvh = absl::ResourceExhaustedError(
-          absl::StrCat("mesh index: out of memory building the BVH of ",
+          absl::StrCat("mesh index: out of memory building the index of ",
                        index->mesh_.num_triangles(), " triangles"));
     }
   });
@@ -146,7 +153,29 @@ absl::StatusOr<std::unique_ptr<MeshIndex>> MeshIndex::Build(TriangleMesh mesh,
   return index;
 }
 
-void MeshIndex::ComputePseudonormals() {
+// The face normals and kernel shapes, which the BVH needs; the edge and
+// vertex pseudonormals below are built beside it.
+void MeshIndex::ComputeFaceNormals() {
+  const auto& verts = mesh_.vertices;
+  const auto& tris = mesh_.triangles;
+  face_normal_.assign(tris.size(), Eigen::Vector3d::Zero());
+  shape_.resize(tris.size());
+  for (std::size_t t = 0; t < tris.size(); ++t) {
+    // The kernel's degeneracy test is TriangleMesh::IsDegenerate's.
+    shape_[t] = ClassifyTriangle(verts[tris[t][0]].cast<double>(), verts[tris[t][1]].cast<double>(),
+                                 verts[tris[t][2]].cast<double>());
+    if (shape_[t] == TriangleShape::kDegenerate) {
+      ++info_.degenerate_triangles;
+      continue;  // a zero normal: contributes nothing to its neighbours' sums
+    }
+    const Eigen::Vector3d a = verts[tris[t][0]].cast<double>(),
+                          b = verts[tris[t][1]].cast<double>(),
+                          c = verts[tris[t][2]].cast<double>();
+    face_normal_[t] = (b - a).cross(c - a).normalized();
+  }
+}
+
+void MeshIndex::ComputeFeatureNormals() {
   const auto& verts = mesh_.vertices;
   const auto& tris = mesh_.triangles;
   // Weld identical positions (an STL from elsewhere may repeat them) so the
@@ -163,22 +192,6 @@ void MeshIndex::ComputePseudonormals() {
     while (j < order.size() && verts[order[j]] == verts[order[i]]) weld_[order[j++]] = order[i];
     info_.welded_vertices += j - i - 1;
     i = j;
-  }
-
-  face_normal_.assign(tris.size(), Eigen::Vector3d::Zero());
-  shape_.resize(tris.size());
-  for (std::size_t t = 0; t < tris.size(); ++t) {
-    // The kernel's degeneracy test is TriangleMesh::IsDegenerate's.
-    shape_[t] = ClassifyTriangle(verts[tris[t][0]].cast<double>(), verts[tris[t][1]].cast<double>(),
-                                 verts[tris[t][2]].cast<double>());
-    if (shape_[t] == TriangleShape::kDegenerate) {
-      ++info_.degenerate_triangles;
-      continue;  // a zero normal: contributes nothing to its neighbours' sums
-    }
-    const Eigen::Vector3d a = verts[tris[t][0]].cast<double>(),
-                          b = verts[tris[t][1]].cast<double>(),
-                          c = verts[tris[t][2]].cast<double>();
-    face_normal_[t] = (b - a).cross(c - a).normalized();
   }
 
   // Edges: sort (welded vertex pair, slot) and sum the face normals per run.

@@ -103,7 +103,8 @@ class MeshIndex {
 
  private:
   MeshIndex() = default;
-  void ComputePseudonormals();
+  void ComputeFaceNormals();
+  void ComputeFeatureNormals();
   const Eigen::Vector3d& Pseudonormal(uint32_t triangle, ClosestFeature feature) const;
 
   TriangleMesh mesh_;
