@@ -21,7 +21,7 @@ FROM debian:bookworm-slim AS runtime
 RUN apt-get update \
  && DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends \
       libabsl20220623 libassimp5 libembree3-3 libfmt9 libgrpc++1.51 libgrpc29 \
-      libmosquitto1 libpcl-common1.13 libpcl-io1.13 libpng16-16 libprometheus-cpp-core1.0 \
+      libmosquitto1 libpng16-16 libprometheus-cpp-core1.0 \
       libprometheus-cpp-pull1.0 libprotobuf32 libpugixml1v5 libspdlog1.10 libssl3 libstdc++6 \
       libtbb12 libcairo2 libglib2.0-0 libpango-1.0-0 libpangocairo-1.0-0 fonts-dejavu-core \
       libsqlite3-0 libpqxx-6.4 libpq5 \

@@ -14,15 +14,15 @@
 #include "bench/peers/clustering_rows.h"
 #include "bench/peers/command_rows.h"
 #include "bench/peers/distance_rows.h"
+#include "bench/peers/quiet_pcl.h"
 #include "bench/peers/report.h"
 #include "bench/peers/service_rows.h"
 #include "core/io/atomic_file.h"
 #include "core/process/buffer_reuse.h"
-#include "core/process/quiet_consoles.h"
 
 int main(int argc, char** argv) {
   surfinspect::ReuseFreedLargeBuffers();  // clouds are ~10 MB buffers, over and over
-  surfinspect::QuietDependencyConsoles();
+  surfinspect::bench::QuietPcl();
   using namespace surfinspect::bench;
   // peers_bench [RESULTS_DIR] [--only SECTION]: --only runs one section
   // (e.g. "service") and prints its rows without touching latest.md.

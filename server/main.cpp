@@ -10,7 +10,6 @@
 #include "absl/strings/ascii.h"
 #include "core/io/atomic_file.h"
 #include "core/process/buffer_reuse.h"
-#include "core/process/quiet_consoles.h"
 #include "server/run_server.h"
 
 namespace {
@@ -92,7 +91,6 @@ int main(int argc, char** argv) {
   sigaddset(&signals, SIGINT);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   surfinspect::ReuseFreedLargeBuffers();  // every call moves ~10 MB buffers
-  surfinspect::QuietDependencyConsoles();
   ServerOptions o;
   o.service.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   std::string token_file;

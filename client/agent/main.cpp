@@ -27,7 +27,6 @@
 #include "core/io/io_mesh.h"
 #include "core/io/io_point_cloud.h"
 #include "core/process/buffer_reuse.h"
-#include "core/process/quiet_consoles.h"
 #include "proto/convert.h"
 
 namespace surfinspect::client {
@@ -431,7 +430,6 @@ void AddVerifyOptions(CLI::App* cmd, AgentArgs& a) {
 int main(int argc, char** argv) {
   using namespace surfinspect::client;
   surfinspect::ReuseFreedLargeBuffers();  // clouds are ~10 MB buffers, over and over
-  surfinspect::QuietDependencyConsoles();
   spdlog::set_default_logger(spdlog::stderr_color_mt("cell-agent"));
   AgentArgs a;
   CLI::App app{"cell-agent: streams a robot cell's scans to surfinspectd and keeps the results"};

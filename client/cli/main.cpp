@@ -5,11 +5,9 @@
 
 #include "client/cli/commands.h"
 #include "core/process/buffer_reuse.h"
-#include "core/process/quiet_consoles.h"
 
 int main(int argc, char** argv) {
   surfinspect::ReuseFreedLargeBuffers();  // clouds are ~10 MB buffers, over and over
-  surfinspect::QuietDependencyConsoles();
   CLI::App app{
       "surfinspect: point-cloud filtering, calibration, registration and "
       "error maps against CAD (units: mm)"};

@@ -1,6 +1,5 @@
 // Point-cloud files: read by our own parsers (pcd_format.h, ply_cloud.h),
-// written through PCL's writers (this is the only translation unit that
-// includes PCL's I/O headers, to keep builds fast).
+// written by our own encoders in PCL's layouts (cloud_write.h).
 //
 // Supported: PCD (ascii, binary, binary_compressed; organized grids and NaN
 // pixels kept bit-exact) and PLY (ascii, binary little/big endian). The x, y,
@@ -9,16 +8,14 @@
 // malformed headers, while ours refuse them with a message.
 #pragma once
 
-#include <cstdint>
 #include <string>
 
 #include "absl/status/statusor.h"
+#include "core/io/cloud_write.h"
 #include "core/io/read_limits.h"
 #include "core/types/point_cloud.h"
 
 namespace surfinspect {
-
-enum class PcdEncoding { kAscii, kBinary, kBinaryCompressed };
 
 // Dispatches on the extension (.pcd or .ply, case-insensitive).
 absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path,

@@ -1,10 +1,13 @@
-// LZF decompression (Marc Lehmann's liblzf format, used by PCD's
-// binary_compressed encoding), written to refuse rather than trust: every
+// LZF (Marc Lehmann's liblzf format, used by PCD's binary_compressed
+// encoding). The decoder is written to refuse rather than trust: every
 // literal run and back reference is checked against the input's end, the
-// output's declared size and the bytes already produced.
+// output's declared size and the bytes already produced. The encoder is a
+// greedy single-probe hash matcher; its stream is valid LZF, though not
+// byte-identical to liblzf's own encoder.
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -21,5 +24,9 @@ inline constexpr uint64_t kLzfMaxExpansion = 88;
 // size, ends short of it, ends inside a token or refers before its start.
 absl::StatusOr<std::vector<uint8_t>> LzfDecompress(std::string_view compressed,
                                                    uint64_t decoded_size);
+
+// Encodes `bytes`. Never fails; incompressible input grows by at most one
+// byte in 32 (a literal run's control byte), plus one.
+std::string LzfCompress(std::string_view bytes);
 
 }  // namespace surfinspect
