@@ -8,12 +8,12 @@
 #include <cmath>
 #include <limits>
 #include <new>
-#include <numeric>
-#include <tuple>
 
 #include "absl/strings/str_cat.h"
 #include "core/distance/embree_handles.h"
 #include "core/distance/wide_bvh.h"
+#include "core/types/first_equal_point.h"
+#include "core/types/radix_sort.h"
 
 namespace surfinspect {
 namespace {
@@ -180,39 +180,40 @@ void MeshIndex::ComputeFeatureNormals() {
   const auto& tris = mesh_.triangles;
   // Weld identical positions (an STL from elsewhere may repeat them) so the
   // adjacency, and with it the edge and vertex pseudonormals, is right.
-  std::vector<uint32_t> order(verts.size());
-  std::iota(order.begin(), order.end(), 0u);
-  auto key = [&](uint32_t i) {
-    return std::make_tuple(verts[i].x(), verts[i].y(), verts[i].z(), i);
-  };
-  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return key(a) < key(b); });
+  // Each vertex welds to the lowest index with its position.
   weld_.resize(verts.size());
-  for (std::size_t i = 0; i < order.size();) {
-    std::size_t j = i;
-    while (j < order.size() && verts[order[j]] == verts[order[i]]) weld_[order[j++]] = order[i];
-    info_.welded_vertices += j - i - 1;
-    i = j;
+  FirstEqualPoint first(verts, verts.size());
+  for (uint32_t i = 0; i < verts.size(); ++i) {
+    weld_[i] = first.FindOrAdd(i);
+    info_.welded_vertices += weld_[i] != i;
   }
 
-  // Edges: sort (welded vertex pair, slot) and sum the face normals per run.
-  std::vector<std::pair<uint64_t, uint32_t>> slots;
+  // Edges: a stable sort of the slots t * 3 + k by welded vertex pair (u <
+  // w, keyed u * n + w), then the face normals summed per run in slot order.
+  const uint64_t n = verts.size();
+  std::vector<uint64_t> keys;
+  std::vector<uint32_t> slots;
+  keys.reserve(tris.size() * 3);
   slots.reserve(tris.size() * 3);
   for (std::size_t t = 0; t < tris.size(); ++t)
     for (int k = 0; k < 3; ++k) {
       uint32_t u = weld_[tris[t][k]], w = weld_[tris[t][(k + 1) % 3]];
       if (u > w) std::swap(u, w);
-      slots.emplace_back((uint64_t{u} << 32) | w, static_cast<uint32_t>(t * 3 + k));
+      keys.push_back(u * n + w);
+      slots.push_back(static_cast<uint32_t>(t * 3 + k));
     }
-  std::sort(slots.begin(), slots.end());
+  int key_bits = 1;
+  while (key_bits < 64 && (n * n - 1) >> key_bits) ++key_bits;
+  RadixSortPairs(keys, slots, key_bits);
   triangle_edges_.resize(tris.size());
   edge_normal_.clear();
   for (std::size_t i = 0; i < slots.size();) {
     std::size_t j = i;
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     const auto id = static_cast<uint32_t>(edge_normal_.size());
-    for (; j < slots.size() && slots[j].first == slots[i].first; ++j) {
-      sum += face_normal_[slots[j].second / 3];
-      triangle_edges_[slots[j].second / 3][slots[j].second % 3] = id;
+    for (; j < slots.size() && keys[j] == keys[i]; ++j) {
+      sum += face_normal_[slots[j] / 3];
+      triangle_edges_[slots[j] / 3][slots[j] % 3] = id;
     }
     if (j - i == 1) ++info_.boundary_edges;
     if (j - i >= 3) ++info_.nonmanifold_edges;

@@ -39,13 +39,15 @@ uint64_t Spread10(uint64_t v) {
   return v;
 }
 
-// Polled every this many points in the single-threaded passes below, so a
+// Polled every this many points in the passes below, so a
 // cancelled call stops within milliseconds even on 10^7 points.
 constexpr std::size_t kCancelStride = std::size_t{1} << 16;
 
 // Visiting order for an unorganized cloud: 30-bit Morton codes on a 1024^3
 // grid over the bounds, sorted by a stable radix sort (equal codes keep
-// input order). Invalid points go last. Empty if cancelled.
+// input order). Invalid points go last. The codes are computed in parallel
+// blocks (each depends only on its point); the sort is serial. Empty if
+// cancelled.
 std::vector<uint32_t> MortonOrder(const PointCloud& cloud, const std::atomic<bool>* cancel) {
   const Bounds3 bounds = ComputeBounds(cloud);
   const std::size_t n = cloud.size();
@@ -53,20 +55,28 @@ std::vector<uint32_t> MortonOrder(const PointCloud& cloud, const std::atomic<boo
   const double scale = extent > 0 ? 1023.0 / extent : 0.0;
   std::vector<uint64_t> keys(n);
   std::vector<uint32_t> order(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    if (i % kCancelStride == 0 && IsCancelled(cancel)) return {};
-    const Eigen::Vector3f& p = cloud.points[i];
-    uint64_t code = uint64_t{1} << 30;
-    if (PointCloud::IsValid(p)) {
-      std::array<uint64_t, 3> q;
-      for (int a = 0; a < 3; ++a)
-        q[a] = static_cast<uint64_t>(std::clamp((p[a] - bounds.min[a]) * scale, 0.0, 1023.0));
-      code = Spread10(q[0]) | (Spread10(q[1]) << 1) | (Spread10(q[2]) << 2);
-    }
-    keys[i] = code;
-    order[i] = static_cast<uint32_t>(i);
-  }
-  if (!RadixSortPairs(keys, order, 31, cancel)) return {};
+  std::atomic<bool> stopped{false};
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, n, kCancelStride),
+      [&](const tbb::blocked_range<std::size_t>& block) {
+        if (IsCancelled(cancel)) {
+          stopped.store(true, std::memory_order_relaxed);
+          return;
+        }
+        for (std::size_t i = block.begin(); i != block.end(); ++i) {
+          const Eigen::Vector3f& p = cloud.points[i];
+          uint64_t code = uint64_t{1} << 30;
+          if (PointCloud::IsValid(p)) {
+            std::array<uint64_t, 3> q;
+            for (int a = 0; a < 3; ++a)
+              q[a] = static_cast<uint64_t>(std::clamp((p[a] - bounds.min[a]) * scale, 0.0, 1023.0));
+            code = Spread10(q[0]) | (Spread10(q[1]) << 1) | (Spread10(q[2]) << 2);
+          }
+          keys[i] = code;
+          order[i] = static_cast<uint32_t>(i);
+        }
+      });
+  if (stopped.load() || !RadixSortPairs(keys, order, 31, cancel)) return {};
   return order;
 }
 
@@ -96,10 +106,11 @@ absl::Status QueryClosestEach(const MeshIndex& index, const PointCloud& points,
   const std::size_t n = points.size();
   if (n == 0) return absl::OkStatus();
   const auto t0 = std::chrono::steady_clock::now();
+  tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
   // A grid is already coherent row by row; anything else gets Morton order.
   std::vector<uint32_t> order;
   if (settings.coherent_start && !points.organized() && n <= UINT32_MAX) {
-    order = MortonOrder(points, cancel);
+    arena.execute([&] { order = MortonOrder(points, cancel); });
     if (order.empty()) return absl::CancelledError("closest-point query cancelled");
   }
   const auto t1 = std::chrono::steady_clock::now();
@@ -142,7 +153,6 @@ absl::Status QueryClosestEach(const MeshIndex& index, const PointCloud& points,
   };
 
   const std::size_t chunks = (n + kChunk - 1) / kChunk;
-  tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks),
                       [&](const tbb::blocked_range<std::size_t>& range) {

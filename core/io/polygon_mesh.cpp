@@ -5,10 +5,10 @@
 #include <cmath>
 #include <exception>
 #include <string>
-#include <unordered_map>
 
 #include "absl/strings/str_cat.h"
 #include "core/io/text_parse.h"
+#include "core/types/first_equal_point.h"
 
 namespace surfinspect {
 namespace {
@@ -80,23 +80,11 @@ std::vector<Triangle> Triangulate(const IndexedPolygons& p) {
   return tris;
 }
 
-struct KeyHash {
-  std::size_t operator()(const Eigen::Vector3f& v) const {
-    std::size_t h = 0;
-    for (int a = 0; a < 3; ++a) h = h * 1000003u ^ std::hash<float>()(v[a] == 0.f ? 0.f : v[a]);
-    return h;
-  }
-};
-struct KeyEq {
-  bool operator()(const Eigen::Vector3f& a, const Eigen::Vector3f& b) const {
-    return a.x() == b.x() && a.y() == b.y() && a.z() == b.z();
-  }
-};
-
 }  // namespace
 
 absl::StatusOr<TriangleMesh> TriangulateAndMerge(const IndexedPolygons& p, std::string_view name) {
   const std::size_t nv = p.vertices.size();
+  if (nv >= UINT32_MAX) return BadFile(name, "cannot import: more than 2^32 - 2 vertices");
   std::size_t total = 0;
   for (uint8_t s : p.sizes) {
     if (s != 3 && s != 4) return BadFile(name, "cannot import: a face is not a triangle or quad");
@@ -112,18 +100,16 @@ absl::StatusOr<TriangleMesh> TriangulateAndMerge(const IndexedPolygons& p, std::
     for (uint32_t i : t) used[i] = true;
   TriangleMesh mesh;
   std::vector<uint32_t> remap(nv, UINT32_MAX);
-  std::unordered_map<Eigen::Vector3f, uint32_t, KeyHash, KeyEq> first;
-  for (std::size_t i = 0; i < nv; ++i) {
+  FirstEqualPoint first(p.vertices, nv);
+  for (uint32_t i = 0; i < nv; ++i) {
     if (!used[i]) continue;
-    const Eigen::Vector3f& v = p.vertices[i];
-    auto it = first.find(v);  // NaN finds nothing: never merged
-    if (it != first.end()) {
-      remap[i] = it->second;
+    const uint32_t f = first.FindOrAdd(i);
+    if (f != i) {
+      remap[i] = remap[f];
       continue;
     }
     remap[i] = static_cast<uint32_t>(mesh.vertices.size());
-    first.emplace(v, remap[i]);
-    mesh.vertices.push_back(v);
+    mesh.vertices.push_back(p.vertices[i]);
   }
   mesh.triangles.reserve(tris.size());
   for (const Triangle& t : tris) mesh.triangles.push_back({remap[t[0]], remap[t[1]], remap[t[2]]});
