@@ -1,6 +1,8 @@
 #include "core/io/ply_mesh.h"
 
 #include <algorithm>
+#include <cstring>
+#include <optional>
 
 #include "absl/strings/str_cat.h"
 #include "core/io/ply_format.h"
@@ -32,6 +34,57 @@ bool Coordinate(PlyFormat f, PlyType t, const PlyValue& v, float* out) {
   return true;
 }
 
+// Little-endian rows of scalars with float32 x, y, z, all present: copied
+// straight from the buffer. False (nothing read) for any other layout or
+// a short buffer, which the row reader then reads or refuses as usual.
+bool TakeFloatRows(PlyRowReader* reader, const PlyHeader& h, const PlyElement& e, const int prop[3],
+                   std::vector<Eigen::Vector3f>* out) {
+  const std::optional<uint64_t> row = e.FixedRowBytes();
+  if (h.format != PlyFormat::kBinaryLittleEndian || !row || *row == 0 ||
+      e.count > reader->RemainingBytes() / *row)
+    return false;
+  uint64_t offset[3];
+  for (int a = 0; a < 3; ++a) {
+    if (e.properties[prop[a]].type != PlyType::kFloat32) return false;
+    offset[a] = 0;
+    for (int i = 0; i < prop[a]; ++i) offset[a] += PlyTypeSize(e.properties[i].type);
+  }
+  const uint8_t* base = nullptr;
+  if (!reader->TakeBytes(*row * e.count, &base).ok()) return false;
+  static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__);
+  out->resize(e.count);
+  for (uint64_t i = 0; i < e.count; ++i)
+    for (int a = 0; a < 3; ++a) std::memcpy(&(*out)[i][a], base + i * *row + offset[a], 4);
+  return true;
+}
+
+// Little-endian faces whose only property is a uchar-counted list of int32
+// or uint32 indices: read in one pass, up to the first face that is not a
+// valid triangle or quad, which is left to the row reader and its message.
+void TakeIndexFaces(PlyRowReader* reader, const PlyHeader& h, const PlyElement& e,
+                    uint64_t vertices, IndexedPolygons* out, uint64_t* faces_read) {
+  const PlyProperty& p = e.properties[0];
+  if (h.format != PlyFormat::kBinaryLittleEndian || e.properties.size() != 1 || !p.is_list ||
+      p.count_type != PlyType::kUint8 || (p.type != PlyType::kInt32 && p.type != PlyType::kUint32))
+    return;
+  static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__);
+  const bool is_signed = p.type == PlyType::kInt32;
+  while (*faces_read < e.count) {
+    const uint8_t* face = nullptr;
+    if (reader->RemainingBytes() < 1 || !reader->TakeBytes(0, &face).ok()) return;
+    const unsigned n = face[0];
+    if (n < 3 || n > 4 || reader->RemainingBytes() < 1 + 4 * n) return;
+    uint32_t idx[4];
+    std::memcpy(idx, face + 1, 4 * n);
+    for (unsigned k = 0; k < n; ++k)
+      if ((is_signed && static_cast<int32_t>(idx[k]) < 0) || idx[k] >= vertices) return;
+    reader->TakeBytes(1 + 4 * n, &face).IgnoreError();  // fits: checked above
+    out->corners.insert(out->corners.end(), idx, idx + n);
+    out->sizes.push_back(static_cast<uint8_t>(n));
+    ++*faces_read;
+  }
+}
+
 absl::Status ReadVertices(PlyRowReader* reader, const PlyHeader& h, const PlyElement& e,
                           std::string_view name, std::vector<Eigen::Vector3f>* out) {
   int prop[3];
@@ -42,6 +95,7 @@ absl::Status ReadVertices(PlyRowReader* reader, const PlyHeader& h, const PlyEle
       return BadFile(
           name, absl::StrCat("cannot import: PLY vertex element has no '", axis[a], "' property"));
   }
+  if (TakeFloatRows(reader, h, e, prop, out)) return absl::OkStatus();
   out->reserve(std::min<uint64_t>(e.count, reader->RemainingBytes() / 2 + 1));
   PlyRow row;
   for (uint64_t i = 0; i < e.count; ++i) {
@@ -64,8 +118,11 @@ absl::Status ReadFaces(PlyRowReader* reader, const PlyHeader& h, const PlyElemen
     return BadFile(name, "cannot import: PLY face element has no integer vertex_indices list");
   const PlyType type = e.properties[prop].type;
   out->sizes.reserve(std::min<uint64_t>(e.count, reader->RemainingBytes() + 1));
+  out->corners.reserve(std::min<uint64_t>(e.count * 3, reader->RemainingBytes() + 1));
+  uint64_t fast = 0;
+  TakeIndexFaces(reader, h, e, vertices, out, &fast);
   PlyRow row;
-  for (uint64_t f = 0; f < e.count; ++f) {
+  for (uint64_t f = fast; f < e.count; ++f) {
     if (auto st = reader->Next(e, f, &row); !st.ok()) return st;
     const uint32_t n = row.first[prop + 1] - row.first[prop];
     if (n < 3)
