@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/filter/link_clustering.h"
+#include "core/filter/link_row_masks_avx2.h"
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -112,8 +113,21 @@ bool RowBits(const RowSoA& cur, const RowSoA& up, uint32_t words, float r2, cons
 
 }  // namespace
 
+bool RowIsaSupported(RowIsa isa) {
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return isa != RowIsa::kAvx2 || avx2;
+}
+
 bool ComputeMasks(const RowSoA& cur, const RowSoA* up, bool diagonals, uint32_t words,
-                  float link_distance_sq, const RowMasks& masks) {
+                  float link_distance_sq, const RowMasks& masks, RowIsa isa) {
+  if (isa == RowIsa::kAvx2 || (isa == RowIsa::kAuto && RowIsaSupported(RowIsa::kAvx2))) {
+    const float* const c[3] = {cur.c(0), cur.c(1), cur.c(2)};
+    const float* const u[3] = {up ? up->c(0) : nullptr, up ? up->c(1) : nullptr,
+                               up ? up->c(2) : nullptr};
+    uint64_t* const m[5] = {masks.valid, masks.west, masks.north_west, masks.north,
+                            masks.north_east};
+    return avx2::RowBits(c, up ? u : nullptr, diagonals, words, link_distance_sq, m);
+  }
   if (!up) return RowBits<false, false>(cur, cur, words, link_distance_sq, masks);
   if (diagonals) return RowBits<true, true>(cur, *up, words, link_distance_sq, masks);
   return RowBits<true, false>(cur, *up, words, link_distance_sq, masks);

@@ -2,8 +2,8 @@
 // sensor row copied to structure-of-arrays, then one pass that turns it into
 // 64-bit masks of valid pixels and of links to the west, north-west, north
 // and north-east neighbours. With SSE2 four pixels are tested per
-// instruction, with the float operations of PointsLinked in its order, so
-// the masks agree bit for bit with the scalar predicate.
+// instruction, with AVX2 eight, with the float operations of PointsLinked in
+// its order, so the masks agree bit for bit with the scalar predicate.
 #pragma once
 
 #include <Eigen/Core>
@@ -33,12 +33,19 @@ struct RowMasks {
 // Copies w points into the SoA row (SSE2: 4 points = 3 loads, 7 shuffles).
 void Transpose(const Eigen::Vector3f* pts, uint32_t w, RowSoA& row);
 
+// The row pass's instruction set. kAuto takes AVX2 (8 pixels per
+// instruction, link_row_masks_avx2.h) where the CPU has it, else SSE2; the
+// masks are the same bits in each.
+enum class RowIsa { kAuto, kSse2, kAvx2 };
+bool RowIsaSupported(RowIsa isa);
+
 // Fills `masks` for `words` 64-pixel words of `cur`: valid (all coordinates
 // finite), west link and, when `up` (the row above) is given, north and, with
 // `diagonals`, north-west and north-east links; NaN never links. Returns
 // whether an infinite coordinate was seen (forbidden by the cloud contract).
+// `isa` must be supported (RowIsaSupported).
 bool ComputeMasks(const RowSoA& cur, const RowSoA* up, bool diagonals, uint32_t words,
-                  float link_distance_sq, const RowMasks& masks);
+                  float link_distance_sq, const RowMasks& masks, RowIsa isa = RowIsa::kAuto);
 
 // Bounds of the pixels first..last of the row, which must all be valid.
 void Bounds(const RowSoA& row, uint32_t first, uint32_t last, float lo[3], float hi[3]);

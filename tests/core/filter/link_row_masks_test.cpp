@@ -15,7 +15,16 @@ bool Bit(const std::vector<uint64_t>& bits, uint32_t i) { return (bits[i / 64] >
 // lattice, so a height step of 4/8 puts a pair at exactly d = 5/8 mm (all
 // exact in float): every mask bit must equal the scalar PointsLinked,
 // ties included (the SIMD path may not round or compare differently).
-TEST(LinkRowMasks, EveryBitEqualsThePointsLinkedPredicate) {
+// Each instruction set's row pass, checked on its own against the scalar
+// predicate (the AVX2 one only where the CPU has AVX2).
+class LinkRowMasks : public ::testing::TestWithParam<RowIsa> {
+ protected:
+  void SetUp() override {
+    if (!RowIsaSupported(GetParam())) GTEST_SKIP() << "this CPU has no AVX2";
+  }
+};
+
+TEST_P(LinkRowMasks, EveryBitEqualsThePointsLinkedPredicate) {
   std::mt19937 rng(4);
   std::uniform_int_distribution<uint32_t> width(1, 200);
   std::uniform_int_distribution<int> lattice(-5, 5);
@@ -45,7 +54,7 @@ TEST(LinkRowMasks, EveryBitEqualsThePointsLinkedPredicate) {
     const RowMasks m = {&storage[0], &storage[words], &storage[2 * words], &storage[3 * words],
                         &storage[4 * words]};
     const bool diagonals = trial % 2 == 0;
-    ASSERT_FALSE(ComputeMasks(cur, &up, diagonals, words, r2, m));
+    ASSERT_FALSE(ComputeMasks(cur, &up, diagonals, words, r2, m, GetParam()));
     auto bits = [&](const uint64_t* p) { return std::vector<uint64_t>(p, p + words); };
     const auto valid = bits(m.valid), west = bits(m.west), nw = bits(m.north_west),
                n = bits(m.north), ne = bits(m.north_east);
@@ -83,20 +92,26 @@ TEST(LinkRowMasks, EveryBitEqualsThePointsLinkedPredicate) {
   EXPECT_GT(ties, 100);
 }
 
-TEST(LinkRowMasks, FirstRowHasNoVerticalLinksAndInfinityIsReported) {
+TEST_P(LinkRowMasks, FirstRowHasNoVerticalLinksAndInfinityIsReported) {
   std::vector<Eigen::Vector3f> pts(70, Eigen::Vector3f(0.f, 0.f, 1.f));
   RowSoA row(128);
   Transpose(pts.data(), 70, row);
   std::vector<uint64_t> storage(10, ~uint64_t{0});
   const RowMasks m = {&storage[0], &storage[2], &storage[4], &storage[6], &storage[8]};
-  EXPECT_FALSE(ComputeMasks(row, nullptr, true, 2, 0.25f, m));
+  EXPECT_FALSE(ComputeMasks(row, nullptr, true, 2, 0.25f, m, GetParam()));
   EXPECT_EQ(storage[6] | storage[7] | storage[4] | storage[5] | storage[8] | storage[9], 0u);
   EXPECT_EQ(storage[0], ~uint64_t{0});
   EXPECT_EQ(storage[1], (uint64_t{1} << 6) - 1);
   pts[69] = {0.f, -INFINITY, NAN};
   Transpose(pts.data(), 70, row);
-  EXPECT_TRUE(ComputeMasks(row, nullptr, true, 2, 0.25f, m));
+  EXPECT_TRUE(ComputeMasks(row, nullptr, true, 2, 0.25f, m, GetParam()));
 }
+
+INSTANTIATE_TEST_SUITE_P(EachIsa, LinkRowMasks, ::testing::Values(RowIsa::kSse2, RowIsa::kAvx2),
+                         [](const ::testing::TestParamInfo<RowIsa>& i) {
+                           return i.param == RowIsa::kAvx2 ? std::string("Avx2")
+                                                           : std::string("Sse2");
+                         });
 
 }  // namespace
 }  // namespace surfinspect::link_row
