@@ -24,7 +24,9 @@ namespace surfinspect {
 
 enum class PcdEncoding { kAscii, kBinary, kBinaryCompressed };
 
-// The whole file. `cloud` must pass Validate().
+// The whole file. `cloud` must pass Validate(); for binary_compressed its
+// planes and their LZF stream must fit the format's uint32 sizes
+// (WritePointCloud refuses clouds of more than 2^32 / 24 points).
 std::string EncodePcd(const PointCloud& cloud, PcdEncoding encoding);
 std::string EncodePly(const PointCloud& cloud, bool binary);
 

@@ -1,5 +1,6 @@
 #include "core/io/io_point_cloud.h"
 
+#include <cstdint>
 #include <limits>
 #include <new>
 
@@ -40,6 +41,11 @@ absl::Status WritePointCloud(const std::string& path, const PointCloud& cloud,
     return Bad(path, "unknown cloud format (expected .pcd or .ply)");
   const bool empty = ext == "ply" ? cloud.CountValid() == 0 : cloud.empty();
   if (empty) return Bad(path, "refusing to write a cloud with no points");
+  // binary_compressed records its sizes as uint32.
+  if (ext == "pcd" && pcd_encoding == PcdEncoding::kBinaryCompressed &&
+      cloud.size() > UINT32_MAX / 12 / 2)
+    return absl::InvalidArgumentError(absl::StrCat(
+        path, ": ", cloud.size(), " points are more than a binary_compressed PCD can hold"));
   std::string bytes;
   try {
     bytes = ext == "pcd" ? EncodePcd(cloud, pcd_encoding) : EncodePly(cloud, ply_binary);
