@@ -16,7 +16,8 @@ bool Bit(const std::vector<uint64_t>& bits, uint32_t i) { return (bits[i / 64] >
 // exact in float): every mask bit must equal the scalar PointsLinked,
 // ties included (the SIMD path may not round or compare differently).
 // Each instruction set's row pass, checked on its own against the scalar
-// predicate (the AVX2 one only where the CPU has AVX2).
+// predicate: core/filter/link_row_masks.cpp (SSE2) and
+// core/filter/link_row_masks_avx2.cpp (only where the CPU has AVX2).
 class LinkRowMasks : public ::testing::TestWithParam<RowIsa> {
  protected:
   void SetUp() override {
