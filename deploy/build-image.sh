@@ -16,7 +16,8 @@
 # Needs root and Debian's podman (apt-get install podman buildah, plus
 # debootstrap for --local-base). The build installs the build dependencies
 # and compiles the project (6-9 minutes on 2 shared cores, measured); it runs
-# under `nice -n 19`. The image is about 840 MB (PCL's I/O pulls in VTK).
+# under `nice -n 19`. The image was about 840 MB while its runtime stage
+# installed PCL's I/O (which pulls in VTK); it has not been measured since.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 LOCAL_BASE=0
