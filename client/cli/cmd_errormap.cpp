@@ -3,6 +3,7 @@
 // PNG and PDF report.
 #include <spdlog/spdlog.h>
 #include <tbb/parallel_invoke.h>
+#include <tbb/task_arena.h>
 
 #include <chrono>
 #include <cstdio>
@@ -337,7 +338,11 @@ void AddErrorMapCommand(CLI::App& app) {
   cmd->callback([a] {
     // Bad parameters are refused before any file is read.
     Check(ValidateErrorMapSettings(a->settings));
-    RunErrorMap(*a);
+    // --threads bounds every step, the two files read at once and the
+    // rows encoded in parallel included.
+    tbb::task_arena arena(a->settings.threads > 0 ? a->settings.threads
+                                                  : tbb::task_arena::automatic);
+    arena.execute([&] { RunErrorMap(*a); });
   });
 }
 
