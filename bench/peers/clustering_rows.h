@@ -145,9 +145,9 @@ inline void AddClusteringRows(std::vector<Row>& rows) {
   // The memory floor: every byte of the scan read once, in the same state
   // of the caches as the runs above (warm, repeated).
   const double floor = MedianSeconds(31, true, [&] { StreamOnce(scan); });
-  rows.push_back({"Link clustering, the same organized scan, against the memory floor",
-                  Time(ours8), Time(floor) + " (read the 9.4 MB scan once, 1 core)",
-                  Fmt("%.1fx", floor / ours8), "ours / floor " + Fmt("%.1f", ours8 / floor),
+  rows.push_back({"Link clustering, the same organized scan, against the memory floor", Time(ours8),
+                  Time(floor) + " (read the 9.4 MB scan once, 1 core)", Fmt("%.1fx", floor / ours8),
+                  "ours / floor " + Fmt("%.1f", ours8 / floor),
                   "≤ 4x the floor; ≥ 8x PCL's organized method",
                   Verdict(ours8 <= 4 * floor) + Fmt(" (%.1fx)", ours8 / floor) + "; " +
                       Verdict(pcl_org / ours8 >= 8) + Fmt(" (%.1fx)", pcl_org / ours8)});
