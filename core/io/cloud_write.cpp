@@ -64,13 +64,6 @@ void AppendCompressed(const PointCloud& cloud, std::string& out) {
   out += packed;
 }
 
-PointCloud ValidOnly(const PointCloud& cloud) {
-  std::vector<Eigen::Vector3f> valid;
-  valid.reserve(cloud.CountValid());
-  cloud.ForEachValid([&](std::size_t, const Eigen::Vector3f& p) { valid.push_back(p); });
-  return PointCloud::Unorganized(std::move(valid));
-}
-
 std::string PlyBinaryHeader(std::size_t count) {
   return absl::StrCat(
       "ply\nformat binary_little_endian 1.0\ncomment PCL generated\n"
@@ -114,21 +107,21 @@ std::string EncodePcd(const PointCloud& cloud, PcdEncoding encoding) {
 }
 
 std::string EncodePly(const PointCloud& cloud, bool binary) {
-  const PointCloud valid = ValidOnly(cloud);
-  if (binary) {
-    std::string out = PlyBinaryHeader(valid.size());
-    AppendRaw(valid, out);
-    return out;
-  }
+  const std::size_t valid = cloud.CountValid();
   std::string out =
-      absl::StrCat("ply\nformat ascii 1.0\ncomment surfinspect\nelement vertex ", valid.size(),
-                   "\nproperty float x\nproperty float y\nproperty float z\nend_header\n");
-  out.reserve(out.size() + valid.size() * 40);
-  for (const Eigen::Vector3f& p : valid.points) {
+      binary ? PlyBinaryHeader(valid)
+             : absl::StrCat("ply\nformat ascii 1.0\ncomment surfinspect\nelement vertex ", valid,
+                            "\nproperty float x\nproperty float y\nproperty float z\nend_header\n");
+  out.reserve(out.size() + valid * (binary ? 12 : 40));
+  cloud.ForEachValid([&](std::size_t, const Eigen::Vector3f& p) {
+    if (binary) {
+      out.append(reinterpret_cast<const char*>(p.data()), 12);
+      return;
+    }
     char buf[96];
     const int len = std::snprintf(buf, sizeof buf, "%.9g %.9g %.9g\n", p.x(), p.y(), p.z());
     out.append(buf, static_cast<std::size_t>(len));
-  }
+  });
   return out;
 }
 
