@@ -100,7 +100,9 @@ ErrorMapRun RemoteErrorMap(const ErrorMapArgs& a, const PointCloud& cloud_in_wor
 ErrorMapRun LocalErrorMap(const ErrorMapArgs& a, const PointCloud& cloud_in_world,
                           const PointCloud& cloud_in_part, const Eigen::Isometry3d& world_from_part,
                           TriangleMesh mesh, const MeshTopology& topo, const InspectionPlan& plan) {
-  const std::unique_ptr<MeshIndex> index = Take(MeshIndex::Build(std::move(mesh)));
+  MeshIndexSettings build;
+  build.build_threads = a.settings.threads;  // 0 = all cores, as for the queries
+  const std::unique_ptr<MeshIndex> index = Take(MeshIndex::Build(std::move(mesh), build));
   spdlog::info(
       "mesh index built in {:.3f} s ({} BVH nodes, {} search; {} boundary edges, {} degenerate "
       "triangles)",
@@ -339,7 +341,8 @@ void AddErrorMapCommand(CLI::App& app) {
     // Bad parameters are refused before any file is read.
     Check(ValidateErrorMapSettings(a->settings));
     // --threads bounds every step, the two files read at once and the
-    // rows encoded in parallel included.
+    // rows encoded in parallel included (the index build is given it too:
+    // it makes an arena of its own).
     tbb::task_arena arena(a->settings.threads > 0 ? a->settings.threads
                                                   : tbb::task_arena::automatic);
     arena.execute([&] { RunErrorMap(*a); });
