@@ -118,9 +118,7 @@ std::string EncodePly(const PointCloud& cloud, bool binary) {
       out.append(reinterpret_cast<const char*>(p.data()), 12);
       return;
     }
-    char buf[96];
-    const int len = std::snprintf(buf, sizeof buf, "%.9g %.9g %.9g\n", p.x(), p.y(), p.z());
-    out.append(buf, static_cast<std::size_t>(len));
+    AppendAsciiPoint(p, out);  // valid: never "nan"
   });
   return out;
 }

@@ -1,7 +1,6 @@
 #include "core/io/ply_cloud.h"
 
 #include <algorithm>
-#include <cstring>
 #include <limits>
 
 #include "absl/strings/str_cat.h"
@@ -70,20 +69,12 @@ absl::Status ReadVertices(PlyRowReader* reader, const PlyHeader& h, const PlyEle
                           const VertexLayout& l, std::string_view name,
                           std::vector<Eigen::Vector3f>* pts) {
   const std::optional<uint64_t> fixed = v.FixedRowBytes();
+  if (TakeFloat32XyzRows(reader, h, v, l.prop, pts)) return absl::OkStatus();
   if (h.format != PlyFormat::kAscii && fixed) {
     const uint8_t* base = nullptr;
     if (!reader->TakeBytes(*fixed * v.count, &base).ok())  // fits: CheckBinarySize passed
       return BadFile(name, "truncated data section");
     pts->resize(v.count);
-    const bool plain = h.format == PlyFormat::kBinaryLittleEndian &&
-                       l.type[0] == PlyType::kFloat32 && l.type[1] == PlyType::kFloat32 &&
-                       l.type[2] == PlyType::kFloat32;
-    if (plain) {  // the host's own floats: copied, bits and all
-      static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__);
-      for (uint64_t i = 0; i < v.count; ++i)
-        for (int a = 0; a < 3; ++a) std::memcpy(&(*pts)[i][a], base + i * *fixed + l.offset[a], 4);
-      return absl::OkStatus();
-    }
     for (uint64_t i = 0; i < v.count; ++i)
       for (int a = 0; a < 3; ++a)
         (*pts)[i][a] = BinaryCoordinate(h.format, l.type[a], base + i * *fixed + l.offset[a]);

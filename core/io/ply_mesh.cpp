@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cstring>
-#include <optional>
 
 #include "absl/strings/str_cat.h"
 #include "core/io/ply_format.h"
@@ -31,30 +30,6 @@ bool Coordinate(PlyFormat f, PlyType t, const PlyValue& v, float* out) {
   int64_t i;
   if (!PlyIntValue(f, t, v, &i)) return false;
   *out = static_cast<float>(i);
-  return true;
-}
-
-// Little-endian rows of scalars with float32 x, y, z, all present: copied
-// straight from the buffer. False (nothing read) for any other layout or
-// a short buffer, which the row reader then reads or refuses as usual.
-bool TakeFloatRows(PlyRowReader* reader, const PlyHeader& h, const PlyElement& e, const int prop[3],
-                   std::vector<Eigen::Vector3f>* out) {
-  const std::optional<uint64_t> row = e.FixedRowBytes();
-  if (h.format != PlyFormat::kBinaryLittleEndian || !row || *row == 0 ||
-      e.count > reader->RemainingBytes() / *row)
-    return false;
-  uint64_t offset[3];
-  for (int a = 0; a < 3; ++a) {
-    if (e.properties[prop[a]].type != PlyType::kFloat32) return false;
-    offset[a] = 0;
-    for (int i = 0; i < prop[a]; ++i) offset[a] += PlyTypeSize(e.properties[i].type);
-  }
-  const uint8_t* base = nullptr;
-  if (!reader->TakeBytes(*row * e.count, &base).ok()) return false;
-  static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__);
-  out->resize(e.count);
-  for (uint64_t i = 0; i < e.count; ++i)
-    for (int a = 0; a < 3; ++a) std::memcpy(&(*out)[i][a], base + i * *row + offset[a], 4);
   return true;
 }
 
@@ -95,7 +70,7 @@ absl::Status ReadVertices(PlyRowReader* reader, const PlyHeader& h, const PlyEle
       return BadFile(
           name, absl::StrCat("cannot import: PLY vertex element has no '", axis[a], "' property"));
   }
-  if (TakeFloatRows(reader, h, e, prop, out)) return absl::OkStatus();
+  if (TakeFloat32XyzRows(reader, h, e, prop, out)) return absl::OkStatus();
   out->reserve(std::min<uint64_t>(e.count, reader->RemainingBytes() / 2 + 1));
   PlyRow row;
   for (uint64_t i = 0; i < e.count; ++i) {

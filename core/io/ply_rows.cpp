@@ -1,6 +1,7 @@
 #include "core/io/ply_rows.h"
 
 #include <cstring>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -198,6 +199,27 @@ double PlyBinaryDouble(PlyFormat format, PlyType type, const uint8_t* raw) {
 
 float PlyBinaryFloat32(PlyFormat format, const uint8_t* raw) {
   return Load<float>(raw, format == PlyFormat::kBinaryBigEndian);
+}
+
+bool TakeFloat32XyzRows(PlyRowReader* reader, const PlyHeader& h, const PlyElement& e,
+                        const int prop[3], std::vector<Eigen::Vector3f>* out) {
+  const std::optional<uint64_t> row = e.FixedRowBytes();
+  if (h.format != PlyFormat::kBinaryLittleEndian || !row || *row == 0 ||
+      e.count > reader->RemainingBytes() / *row)
+    return false;
+  uint64_t offset[3];
+  for (int a = 0; a < 3; ++a) {
+    if (e.properties[prop[a]].type != PlyType::kFloat32) return false;
+    offset[a] = 0;
+    for (int i = 0; i < prop[a]; ++i) offset[a] += PlyTypeSize(e.properties[i].type);
+  }
+  const uint8_t* base = nullptr;
+  if (!reader->TakeBytes(*row * e.count, &base).ok()) return false;
+  static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__);
+  out->resize(e.count);
+  for (uint64_t i = 0; i < e.count; ++i)
+    for (int a = 0; a < 3; ++a) std::memcpy(&(*out)[i][a], base + i * *row + offset[a], 4);
+  return true;
 }
 
 }  // namespace surfinspect

@@ -5,6 +5,7 @@
 // is checked against what is left before anything is read.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <string_view>
 #include <vector>
@@ -60,5 +61,13 @@ bool PlyIntValue(PlyFormat format, PlyType type, const PlyValue& v, int64_t* out
 double PlyBinaryDouble(PlyFormat format, PlyType type, const uint8_t* raw);
 // A binary float32 with its bits kept (NaN payloads included).
 float PlyBinaryFloat32(PlyFormat format, const uint8_t* raw);
+
+// All rows of `element` when they are little-endian rows of scalars whose
+// x, y, z (properties prop[0..2]) are float32: copied straight from the
+// buffer into `out`, bits and all, in one pass. False, with nothing read,
+// for any other layout or a buffer too short for the rows, which the caller
+// then reads row by row (or refuses) as usual.
+bool TakeFloat32XyzRows(PlyRowReader* reader, const PlyHeader& header, const PlyElement& element,
+                        const int prop[3], std::vector<Eigen::Vector3f>* out);
 
 }  // namespace surfinspect
