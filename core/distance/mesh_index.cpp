@@ -259,6 +259,7 @@ ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_dis
                  static_cast<float>(p_in_mesh.z())},
                 max_distance_mm * max_distance_mm,
                 SearchRadius2(SearchRadius(max_distance_mm, s.coordinate_scale)),
+                LeafMargin(p_in_mesh),
                 &s,
                 &OfferLane};
   // Beyond float range the boxes cannot place the point; such a point is unmatched.

@@ -27,7 +27,6 @@ namespace surfinspect {
 namespace {
 
 constexpr std::size_t kChunk = 256;  // points per chunk: the unit of work and of cancel polling
-constexpr std::size_t kPrefetchAhead = 4;  // points; a search takes ~0.5 us, a miss ~0.1 us
 
 // Spreads the low 10 bits of v to every third bit (Morton interleave).
 uint64_t Spread10(uint64_t v) {
@@ -46,15 +45,14 @@ constexpr std::size_t kCancelStride = std::size_t{1} << 16;
 // Visiting order for an unorganized cloud: 30-bit Morton codes on a 1024^3
 // grid over the bounds, sorted by a stable radix sort (equal codes keep
 // input order). Invalid points go last. The codes are computed in parallel
-// blocks (each depends only on its point); the sort is serial. Empty if
+// blocks (each depends only on its point), and so is the sort. Empty if
 // cancelled.
 std::vector<uint32_t> MortonOrder(const PointCloud& cloud, const std::atomic<bool>* cancel) {
   const Bounds3 bounds = ComputeBounds(cloud);
   const std::size_t n = cloud.size();
   const double extent = bounds.empty() ? 0.0 : (bounds.max - bounds.min).maxCoeff();
   const double scale = extent > 0 ? 1023.0 / extent : 0.0;
-  std::vector<uint64_t> keys(n);
-  std::vector<uint32_t> order(n);
+  std::vector<uint64_t> items(n);  // code << 32 | point index
   std::atomic<bool> stopped{false};
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, n, kCancelStride),
@@ -72,11 +70,16 @@ std::vector<uint32_t> MortonOrder(const PointCloud& cloud, const std::atomic<boo
               q[a] = static_cast<uint64_t>(std::clamp((p[a] - bounds.min[a]) * scale, 0.0, 1023.0));
             code = Spread10(q[0]) | (Spread10(q[1]) << 1) | (Spread10(q[2]) << 2);
           }
-          keys[i] = code;
-          order[i] = static_cast<uint32_t>(i);
+          items[i] = code << 32 | i;
         }
       });
-  if (stopped.load() || !RadixSortPairs(keys, order, 31, cancel)) return {};
+  if (stopped.load() || !RadixSortPacked(items, 31, cancel)) return {};
+  std::vector<uint32_t> order(n);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kCancelStride),
+                    [&](const tbb::blocked_range<std::size_t>& block) {
+                      for (std::size_t i = block.begin(); i != block.end(); ++i)
+                        order[i] = static_cast<uint32_t>(items[i]);
+                    });
   return order;
 }
 
@@ -117,39 +120,46 @@ absl::Status QueryClosestEach(const MeshIndex& index, const PointCloud& points,
 
   const double max_d = settings.max_distance_mm;
   std::atomic<bool> cancelled{false};
+  // A chunk runs in three passes: gather its points, search them, hand the
+  // results to the sink. In Morton order the input is read and the sink
+  // writes at random; apart from the searches those cache misses overlap
+  // each other instead of each stalling a search (about a fifth of the time
+  // on 10^6 points).
   auto run_chunk = [&](std::size_t chunk) {
+    const std::size_t begin = chunk * kChunk, count = std::min(n - begin, kChunk);
+    auto index_of = [&](std::size_t k) { return order.empty() ? begin + k : order[begin + k]; };
+    std::array<Eigen::Vector3d, kChunk> p;  // mesh frame
+    std::array<bool, kChunk> valid;
+    for (std::size_t k = 0; k < count; ++k) {
+      const Eigen::Vector3f& q = points.points[index_of(k)];
+      valid[k] = PointCloud::IsValid(q);
+      if (valid[k]) p[k] = mesh_from_points * q.cast<double>();
+    }
+    std::array<ClosestPoint, kChunk> results;
     Eigen::Vector3d prev_p = Eigen::Vector3d::Zero();
     double prev_d = NAN;  // no anchor yet
     uint32_t prev_triangle = UINT32_MAX;
-    const std::size_t end = std::min(n, (chunk + 1) * kChunk);
-    for (std::size_t k = chunk * kChunk; k < end; ++k) {
-      // In Morton order the input is read at random: without a prefetch,
-      // the load of each point waits out a cache miss (~15% of a query).
-      if (!order.empty() && k + kPrefetchAhead < end)
-        __builtin_prefetch(&points.points[order[k + kPrefetchAhead]]);
-      const std::size_t i = order.empty() ? k : order[k];
-      const Eigen::Vector3f& q = points.points[i];
-      if (!PointCloud::IsValid(q)) {
-        sink(i, ClosestPoint{});
+    for (std::size_t k = 0; k < count; ++k) {
+      ClosestPoint& r = results[k];
+      if (!valid[k]) {
+        r = ClosestPoint{};
         continue;
       }
-      const Eigen::Vector3d p = mesh_from_points * q.cast<double>();
       double radius = max_d;
       if (settings.coherent_start && std::isfinite(prev_d))
-        radius = std::min(radius, (prev_d + (p - prev_p).norm()) * (1 + 1e-12) + 1e-12);
+        radius = std::min(radius, (prev_d + (p[k] - prev_p).norm()) * (1 + 1e-12) + 1e-12);
       // The previous point's triangle, offered first, usually makes the
       // radius nearly exact at once.
-      ClosestPoint r =
-          index.Closest(p, radius, settings.coherent_start ? prev_triangle : UINT32_MAX);
+      r = index.Closest(p[k], radius, settings.coherent_start ? prev_triangle : UINT32_MAX);
       // The bound holds exactly; this only guards against its rounding.
-      if (!r.matched() && radius < max_d) r = index.Closest(p, max_d);
-      sink(i, r);
+      if (!r.matched() && radius < max_d) r = index.Closest(p[k], max_d);
       if (r.matched()) {
-        prev_p = p;
+        prev_p = p[k];
         prev_d = r.distance_mm;
         prev_triangle = r.triangle_id;
       }
     }
+    for (std::size_t k = 0; k < count; ++k) sink(index_of(k), results[k]);
   };
 
   const std::size_t chunks = (n + kChunk - 1) / kChunk;

@@ -70,6 +70,13 @@ struct RtcBvh {
 // is off by at most 2^-24 of itself, so a dot product with p - v by at most
 // 2^-24 |p - v|_1. 2e-7 is more than three times that.
 constexpr double kFloatStorageSlack = 2e-7;
+// And for computing the bound in float: 4 2^-24 |p - v|_1 per term, plus
+// the roundings of the slack's product and the subtractions, 1e-6 is more
+// than twice all of them (wide_bvh_search.cpp).
+constexpr double kFloatArithmeticSlack = 1e-6;
+// Beyond 1 a slack zeroes a term in any case; the cap keeps its product's
+// error inside the query's leaf margin.
+constexpr float kMaxSlack = 2;
 
 }  // namespace
 
@@ -216,9 +223,9 @@ absl::StatusOr<WideBvh> WideBvh::Build(RTCDevice device, const TriangleMesh& mes
   args.buildQuality = quality;
   args.maxBranchingFactor = wide::kWidth;
   args.maxDepth = wide::kMaxDepth;
-  args.sahBlockSize = wide::kLeafWidth;  // a leaf of 4 costs as much as one of 1
+  args.sahBlockSize = wide::kMaxLeafTriangles;  // a leaf of 4 costs as much as one of 1
   args.minLeafSize = 1;
-  args.maxLeafSize = wide::kLeafWidth;
+  args.maxLeafSize = wide::kMaxLeafTriangles;
   args.traversalCost = 1.0f;
   args.intersectionCost = 1.0f;
   args.bvh = bvh.bvh;
@@ -263,18 +270,22 @@ void FillLeafLane(wide::LeafBlock& block, int lane, uint32_t t, const Eigen::Vec
     }
     block.normal[axis][lane] = static_cast<float>(n[axis]);
   }
-  block.slack[lane] = RoundUpToFloat(bound.slack + kFloatStorageSlack);
+  block.slack[lane] =
+      std::min(RoundUpToFloat(bound.slack + kFloatStorageSlack + kFloatArithmeticSlack), kMaxSlack);
   block.triangle[lane] = t;
   block.shape[lane] = static_cast<uint8_t>(shape);
 }
 
+float LeafMargin(const Eigen::Vector3d& p) { return RoundUpToFloat(8 * 0x1p-24 * p.lpNorm<1>()); }
+
 void LeafBounds2(SearchIsa isa, const wide::LeafBlock& block, const Eigen::Vector3d& p,
-                 double out[wide::kLeafWidth]) {
-  const double q[3] = {p.x(), p.y(), p.z()};
+                 float out[wide::kLeafWidth]) {
+  const float q[3] = {static_cast<float>(p.x()), static_cast<float>(p.y()),
+                      static_cast<float>(p.z())};
   if (ResolveSearchIsa(isa) == SearchIsa::kAvx2 && SearchIsaSupported(SearchIsa::kAvx2))
-    wide::avx2::BlockBounds2(block, q, out);
+    wide::avx2::BlockBounds2(block, q, LeafMargin(p), out);
   else
-    wide::sse2::BlockBounds2(block, q, out);
+    wide::sse2::BlockBounds2(block, q, LeafMargin(p), out);
 }
 
 }  // namespace surfinspect

@@ -1,7 +1,7 @@
 // The mesh index's BVH: built by Embree (rtcBuildBVH, binned SAH or Morton,
 // 8 children per node, leaves of at most 4 triangles) and copied into our
 // own flat layout (core/distance/wide_bvh_layout.h), which a nearest-first
-// search walks 8 boxes and 4 triangle bounds at a time
+// search walks 8 boxes and 8 triangle bounds at a time
 // (core/distance/wide_bvh_search.cpp). The search only culls: every
 // triangle it cannot rule out is handed to the caller's exact kernel, so
 // the answer is the brute-force answer whatever the instruction set.
@@ -90,9 +90,13 @@ inline float RoundUpToFloat(double v) {
 }
 // A block with every lane unused.
 wide::LeafBlock EmptyLeafBlock();
+// The query's share of the float leaf bound's error: 8 2^-24 |p|_1, rounded
+// up (core/distance/wide_bvh_search.cpp).
+float LeafMargin(const Eigen::Vector3d& p);
 // The leaf bound of the given ISA (the tests compare them); SSE2 when this
-// machine lacks the ISA.
+// machine lacks the ISA. At most 3 2^-24 above the exact squared prism
+// bound, which is at most the squared distance.
 void LeafBounds2(SearchIsa isa, const wide::LeafBlock& block, const Eigen::Vector3d& p,
-                 double out[wide::kLeafWidth]);
+                 float out[wide::kLeafWidth]);
 
 }  // namespace surfinspect

@@ -17,9 +17,10 @@ enum class SearchIsa { kAuto, kSse2, kAvx2 };
 
 namespace surfinspect::wide {
 
-constexpr int kWidth = 8;      // children per node: one 256-bit register of floats
-constexpr int kLeafWidth = 4;  // triangles per leaf block: one 256-bit register of doubles
-constexpr int kMaxDepth = 64;  // passed to the builder, which fails beyond it
+constexpr int kWidth = 8;             // children per node: one 256-bit register of floats
+constexpr int kLeafWidth = 8;         // triangles per leaf block: one 256-bit register of floats
+constexpr int kMaxLeafTriangles = 8;  // Embree's leaves; they are packed into blocks
+constexpr int kMaxDepth = 64;         // passed to the builder, which fails beyond it
 constexpr int kStackSize = kMaxDepth * (kWidth - 1) + kWidth;
 
 // Eight child boxes in structure-of-arrays form. The boxes are the exact
@@ -32,7 +33,7 @@ struct alignas(32) Node {
   uint32_t count;                  // children in use, from the front
 };
 
-// Four consecutive leaf lanes (lane k of block b is lane 4b + k of the
+// Eight consecutive leaf lanes (lane k of block b is lane 8b + k of the
 // leaves; a leaf is a run of lanes and may span two blocks), each a
 // triangle with what the leaf's lower bound needs, stored as
 // floats: the vertices exactly, the unit face normal n and the in-plane
@@ -59,7 +60,8 @@ struct Query {
   double p[3];
   float pf[3];        // p rounded to float, for the boxes
   double best_d2;     // the best squared distance so far, or the squared limit
-  float box_radius2;  // boxes whose float squared distance exceeds this are culled
+  float box_radius2;  // boxes and leaf lanes whose float squared distance exceeds this are culled
+  float leaf_margin;  // LeafMargin(p) (core/distance/wide_bvh.h)
   void* context;
   bool (*offer)(Query& query, const LeafBlock& block, int lane);
 };
@@ -68,11 +70,11 @@ struct Query {
 // are the same in each (the tests compare them).
 namespace sse2 {
 void Search(const View& view, Query& query);
-void BlockBounds2(const LeafBlock& block, const double p[3], double out[kLeafWidth]);
+void BlockBounds2(const LeafBlock& block, const float p[3], float margin, float out[kLeafWidth]);
 }  // namespace sse2
 namespace avx2 {
 void Search(const View& view, Query& query);
-void BlockBounds2(const LeafBlock& block, const double p[3], double out[kLeafWidth]);
+void BlockBounds2(const LeafBlock& block, const float p[3], float margin, float out[kLeafWidth]);
 }  // namespace avx2
 
 }  // namespace surfinspect::wide

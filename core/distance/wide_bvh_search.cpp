@@ -3,8 +3,8 @@
 // the build adds that set's flags (-mavx2 -mfma for avx2, none for sse2)
 // and -ffp-contract=off, so no multiply-add is fused differently in one
 // set than in another. The code is written in GCC vector extensions, so
-// the same operations in the same order run 8 floats or 4 doubles wide in
-// one AVX2 register or in two SSE2 registers: every lane computes the same
+// the same operations in the same order run 8 floats wide in one AVX2
+// register or in two SSE2 registers: every lane computes the same
 // IEEE values in both.
 //
 // Boxes (float): the gap to a box along an axis is max(lo - p, p - hi, 0)
@@ -18,10 +18,21 @@
 // below the best distance: the true minimiser and every exact tie are
 // always reached.
 //
-// Leaves (double): the prism bound of core/distance/prism_bound.h, four
-// triangles at a time, with the stored float normals' rounding inside the
-// slack. Triangles whose bound exceeds the best squared distance go no
-// further; the rest are offered to the exact kernel.
+// Leaves (float): the prism bound of core/distance/prism_bound.h, eight
+// triangles at a time, from p rounded to float. With u = 2^-24, each of its
+// terms t = n.(p - v) (n the face normal or an edge normal, |n_i| <= 1) is
+// computed within u |p|_1 (rounding p) + 4u |p - v|_1 (the subtraction,
+// three products, two sums) of its value at the double point. Each lane's
+// slack holds the double bound's, plus 2e-7 for storing n as floats, plus
+// 1e-6 for that arithmetic, times |p - v|_1, capped at 2 (a slack of 1
+// already zeroes a term); the query's leaf margin, 8u |p|_1 rounded up,
+// covers rounding p and its effect on the slack's own product
+// (wide_bvh.cpp). So each term, and
+// with it below and out, lands at or under its exact value, and the float
+// below^2 + out^2 at most 3u over the exact squared bound. Lanes are culled
+// only against the padded box radius above, at least (1 + 2e-6) times the
+// best squared distance: every triangle at or below the best distance is
+// offered to the exact kernel.
 #include <immintrin.h>  // gnu_inline intrinsics only: nothing out of line is emitted
 
 #include <cstdint>
@@ -40,32 +51,20 @@ namespace {
 #define SURFINSPECT_INLINE inline __attribute__((always_inline))
 
 typedef float F8 __attribute__((vector_size(32)));
-typedef double D4 __attribute__((vector_size(32)));
-typedef int64_t L4 __attribute__((vector_size(32)));
+typedef int32_t I8 __attribute__((vector_size(32)));
 
 // Arithmetic is written with the vector operators; what GCC would lower
 // lane by lane on SSE2 (comparisons, max) goes through these, which use the
-// same instruction semantics in both sets (maxps / maxpd, cmpleps / cmplepd).
+// same instruction semantics in both sets (maxps, cmpleps).
 #ifdef __AVX2__
 SURFINSPECT_INLINE F8 Max(F8 a, F8 b) {
   return reinterpret_cast<F8>(
       _mm256_max_ps(reinterpret_cast<__m256>(a), reinterpret_cast<__m256>(b)));
 }
-SURFINSPECT_INLINE D4 Max(D4 a, D4 b) {
-  return reinterpret_cast<D4>(
-      _mm256_max_pd(reinterpret_cast<__m256d>(a), reinterpret_cast<__m256d>(b)));
-}
 // Bit i set when lane i of v is <= limit.
 SURFINSPECT_INLINE uint32_t LessEqualMask(F8 v, float limit) {
   return static_cast<uint32_t>(_mm256_movemask_ps(
       _mm256_cmp_ps(reinterpret_cast<__m256>(v), _mm256_set1_ps(limit), _CMP_LE_OQ)));
-}
-SURFINSPECT_INLINE uint32_t LessEqualMask(D4 v, double limit) {
-  return static_cast<uint32_t>(_mm256_movemask_pd(
-      _mm256_cmp_pd(reinterpret_cast<__m256d>(v), _mm256_set1_pd(limit), _CMP_LE_OQ)));
-}
-SURFINSPECT_INLINE D4 LoadD4(const float* p) {
-  return reinterpret_cast<D4>(_mm256_cvtps_pd(_mm_load_ps(p)));
 }
 #else
 template <class V, class H>
@@ -90,27 +89,12 @@ SURFINSPECT_INLINE V PerHalf(V a, V b, Op op) {
 SURFINSPECT_INLINE F8 Max(F8 a, F8 b) {
   return PerHalf<__m128>(a, b, [](__m128 x, __m128 y) { return _mm_max_ps(x, y); });
 }
-SURFINSPECT_INLINE D4 Max(D4 a, D4 b) {
-  return PerHalf<__m128d>(a, b, [](__m128d x, __m128d y) { return _mm_max_pd(x, y); });
-}
 SURFINSPECT_INLINE uint32_t LessEqualMask(F8 v, float limit) {
   __m128 x[2];
   Split(v, x);
   const __m128 l = _mm_set1_ps(limit);
   return static_cast<uint32_t>(_mm_movemask_ps(_mm_cmple_ps(x[0], l)) |
                                (_mm_movemask_ps(_mm_cmple_ps(x[1], l)) << 4));
-}
-SURFINSPECT_INLINE uint32_t LessEqualMask(D4 v, double limit) {
-  __m128d x[2];
-  Split(v, x);
-  const __m128d l = _mm_set1_pd(limit);
-  return static_cast<uint32_t>(_mm_movemask_pd(_mm_cmple_pd(x[0], l)) |
-                               (_mm_movemask_pd(_mm_cmple_pd(x[1], l)) << 2));
-}
-SURFINSPECT_INLINE D4 LoadD4(const float* p) {
-  const __m128 v = _mm_load_ps(p);
-  const __m128d half[2] = {_mm_cvtps_pd(v), _mm_cvtps_pd(_mm_movehl_ps(v, v))};
-  return Join<D4>(half);
 }
 #endif
 
@@ -120,8 +104,8 @@ SURFINSPECT_INLINE F8 LoadF8(const float* p) {
   return v;
 }
 
-SURFINSPECT_INLINE D4 Abs(D4 v) {
-  return reinterpret_cast<D4>(reinterpret_cast<L4>(v) & (L4{} + INT64_MAX));
+SURFINSPECT_INLINE F8 Abs(F8 v) {
+  return reinterpret_cast<F8>(reinterpret_cast<I8>(v) & (I8{} + INT32_MAX));
 }
 
 // The float squared distance from the point to each of the node's boxes.
@@ -136,29 +120,32 @@ SURFINSPECT_INLINE F8 BoxDistance2(const Node& node, const F8 p[3]) {
   return d2;
 }
 
-// below^2 + out^2 per lane (prism_bound.h), in double.
-SURFINSPECT_INLINE D4 Bounds2(const LeafBlock& block, const double p[3]) {
-  D4 d[3][3];  // p - vertex k
-  D4 l1[3];    // |p - vertex k|_1
+// below^2 + out^2 per lane (prism_bound.h), in float, never above the
+// exact squared bound by more than 3u of it (see the top of this file).
+SURFINSPECT_INLINE F8 Bounds2(const LeafBlock& block, const F8 p[3], float margin) {
+  F8 d[3][3];  // p - vertex k
+  F8 l1[3];    // |p - vertex k|_1
   for (int k = 0; k < 3; ++k) {
-    for (int axis = 0; axis < 3; ++axis) d[k][axis] = p[axis] - LoadD4(block.vertex[k][axis]);
+    for (int axis = 0; axis < 3; ++axis) d[k][axis] = p[axis] - LoadF8(block.vertex[k][axis]);
     l1[k] = Abs(d[k][0]) + Abs(d[k][1]) + Abs(d[k][2]);
   }
-  const D4 slack = LoadD4(block.slack);
-  const D4 below = Max(Abs(LoadD4(block.normal[0]) * d[0][0] + LoadD4(block.normal[1]) * d[0][1] +
-                           LoadD4(block.normal[2]) * d[0][2]) -
-                           slack * l1[0],
-                       D4{});
-  D4 out = {};
+  const F8 slack = LoadF8(block.slack);
+  const F8 m = F8{} + margin;
+  const F8 below = Max(Abs(LoadF8(block.normal[0]) * d[0][0] + LoadF8(block.normal[1]) * d[0][1] +
+                           LoadF8(block.normal[2]) * d[0][2]) -
+                           slack * l1[0] - m,
+                       F8{});
+  F8 out = {};
   for (int k = 0; k < 3; ++k)
-    out = Max(LoadD4(block.edge[k][0]) * d[k][0] + LoadD4(block.edge[k][1]) * d[k][1] +
-                  LoadD4(block.edge[k][2]) * d[k][2] - slack * l1[k],
+    out = Max(LoadF8(block.edge[k][0]) * d[k][0] + LoadF8(block.edge[k][1]) * d[k][1] +
+                  LoadF8(block.edge[k][2]) * d[k][2] - slack * l1[k] - m,
               out);
   return below * below + out * out;
 }
 
 // The leaf of lanes [first, first + count), one block at a time.
-SURFINSPECT_INLINE void VisitLeaf(const View& view, uint32_t first, uint32_t count, Query& q) {
+SURFINSPECT_INLINE void VisitLeaf(const View& view, uint32_t first, uint32_t count, const F8 p[3],
+                                  Query& q) {
   const uint32_t end = first + count;
   for (uint32_t b = first / kLeafWidth; b * kLeafWidth < end; ++b) {
     const LeafBlock& block = view.blocks[b];
@@ -166,13 +153,13 @@ SURFINSPECT_INLINE void VisitLeaf(const View& view, uint32_t first, uint32_t cou
     const uint32_t from = first > base ? first - base : 0;
     const uint32_t to = end - base < kLeafWidth ? end - base : kLeafWidth;
     const uint32_t lanes = ((1u << to) - 1) & ~((1u << from) - 1);
-    const D4 bound2 = Bounds2(block, q.p);
-    uint32_t mask = LessEqualMask(bound2, q.best_d2) & lanes;
+    const F8 bound2 = Bounds2(block, p, q.leaf_margin);
+    uint32_t mask = LessEqualMask(bound2, q.box_radius2) & lanes;
     while (mask != 0) {
       const int lane = __builtin_ctz(mask);
       mask &= mask - 1;
       // An earlier lane may have lowered the best distance since.
-      if (bound2[lane] <= q.best_d2) q.offer(q, block, lane);
+      if (bound2[lane] <= q.box_radius2) q.offer(q, block, lane);
     }
   }
 }
@@ -210,7 +197,7 @@ void Search(const View& view, Query& q) {
   for (;;) {
     if (next.d2 <= q.box_radius2) {
       if (next.leaf_triangles != 0) {
-        VisitLeaf(view, next.child, next.leaf_triangles, q);
+        VisitLeaf(view, next.child, next.leaf_triangles, p, q);
       } else {
         Entry live[kWidth];
         const int n = LiveChildren(view.nodes[next.child], p, q.box_radius2, live);
@@ -227,8 +214,9 @@ void Search(const View& view, Query& q) {
   }
 }
 
-void BlockBounds2(const LeafBlock& block, const double p[3], double out[kLeafWidth]) {
-  const D4 bound2 = Bounds2(block, p);
+void BlockBounds2(const LeafBlock& block, const float p[3], float margin, float out[kLeafWidth]) {
+  const F8 pv[3] = {F8{} + p[0], F8{} + p[1], F8{} + p[2]};
+  const F8 bound2 = Bounds2(block, pv, margin);
   for (int lane = 0; lane < kLeafWidth; ++lane) out[lane] = bound2[lane];
 }
 

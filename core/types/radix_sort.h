@@ -1,7 +1,7 @@
-// A stable LSD radix sort of (key, value) pairs with 11-bit digits: O(n) per
-// pass, so a 31-bit key takes 3 passes. The link-clustering voxel grid sorts
-// points by packed cell key with it, and the batch closest-point queries
-// sort points by Morton code.
+// Stable LSD radix sorts with 11-bit digits: O(n) per pass, so a 31-bit
+// key takes 3 passes. The link-clustering voxel grid sorts points by packed
+// cell key with them, and the batch closest-point queries sort points by
+// Morton code.
 #pragma once
 
 #include <atomic>
@@ -16,5 +16,11 @@ namespace surfinspect {
 // is set (the pairs are then in an unspecified order); true otherwise.
 bool RadixSortPairs(std::vector<uint64_t>& keys, std::vector<uint32_t>& values, int key_bits,
                     const std::atomic<bool>* cancel = nullptr);
+
+// The same for pairs packed as key << 32 | value (key < 2^key_bits,
+// key_bits <= 32), with 10-bit digits: half the bytes of the unpacked form
+// move per pass, and each pass writes to fewer places at once.
+bool RadixSortPacked(std::vector<uint64_t>& items, int key_bits,
+                     const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace surfinspect

@@ -79,7 +79,7 @@ void CheckSubtree(const wide::View& v, const TriangleMesh& m, uint32_t node, int
       CheckSubtree(v, m, n.child[i], depth + 1, seen, max_depth);
       continue;
     }
-    ASSERT_LE(n.leaf_triangles[i], wide::kLeafWidth);
+    ASSERT_LE(n.leaf_triangles[i], wide::kMaxLeafTriangles);
     for (uint32_t j = n.child[i]; j < n.child[i] + n.leaf_triangles[i]; ++j) {
       const wide::LeafBlock& block = v.blocks[j / wide::kLeafWidth];
       const int lane = static_cast<int>(j % wide::kLeafWidth);
@@ -110,7 +110,8 @@ TEST(WideBvh, EveryTriangleIsInOneLeafInsideEveryBoxAboveIt) {
       CheckSubtree(bvh.view(), m, 0, 1, seen, depth);
       for (int s : seen) ASSERT_EQ(s, 1);
       // The lanes are packed: no block is more than needed.
-      EXPECT_EQ(bvh.stats().leaf_blocks, (m.num_triangles() + 3) / 4);
+      EXPECT_EQ(bvh.stats().leaf_blocks,
+                (m.num_triangles() + wide::kLeafWidth - 1) / wide::kLeafWidth);
       EXPECT_EQ(depth, bvh.stats().depth);
       EXPECT_LE(depth, wide::kMaxDepth);
       EXPECT_GT(bvh.memory_bytes(), 0u);
@@ -160,6 +161,7 @@ TEST(WideBvh, SearchFindsTheBruteForceMinimiserInEveryIsaAndPrunes) {
           {static_cast<float>(r.p.x()), static_cast<float>(r.p.y()), static_cast<float>(r.p.z())},
           INFINITY,
           INFINITY,
+          LeafMargin(r.p),
           &r,
           &Record};
       bvh.Search(q);

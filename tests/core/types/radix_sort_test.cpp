@@ -44,5 +44,37 @@ TEST(RadixSort, StopsWhenCancelled) {
   EXPECT_EQ(values, (std::vector<uint32_t>{1, 2, 0}));
 }
 
+// The packed form gives RadixSortPairs' order, with few distinct keys so
+// stability shows, and past the cancel stride (2^16 items).
+TEST(RadixSort, PackedMatchesThePairSort) {
+  std::mt19937_64 rng(5);
+  for (int key_bits : {1, 11, 12, 31, 32})
+    for (std::size_t n : {std::size_t{0}, std::size_t{3}, std::size_t{5000}, std::size_t{200000}}) {
+      const uint64_t mask = (uint64_t{1} << key_bits) - 1;
+      std::vector<uint64_t> keys(n), packed(n);
+      std::vector<uint32_t> values(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        keys[i] = rng() & mask & (key_bits > 11 ? 0xfff0f : mask);
+        values[i] = static_cast<uint32_t>(rng());
+        packed[i] = keys[i] << 32 | values[i];
+      }
+      ASSERT_TRUE(RadixSortPairs(keys, values, key_bits));
+      ASSERT_TRUE(RadixSortPacked(packed, key_bits));
+      for (std::size_t i = 0; i < n; ++i) {
+        ASSERT_EQ(packed[i] >> 32, keys[i]) << key_bits << " bits, item " << i;
+        ASSERT_EQ(static_cast<uint32_t>(packed[i]), values[i]) << key_bits << " bits, item " << i;
+      }
+    }
+}
+
+TEST(RadixSort, PackedStopsWhenCancelled) {
+  std::vector<uint64_t> items = {uint64_t{3} << 32, uint64_t{1} << 32 | 1};
+  std::atomic<bool> cancel{true};
+  EXPECT_FALSE(RadixSortPacked(items, 2, &cancel));
+  cancel = false;
+  ASSERT_TRUE(RadixSortPacked(items, 2, &cancel));
+  EXPECT_EQ(items[0], uint64_t{1} << 32 | 1);
+}
+
 }  // namespace
 }  // namespace surfinspect
