@@ -16,7 +16,11 @@
 #include <pcl/segmentation/euclidean_cluster_comparator.h>
 #include <pcl/segmentation/extract_clusters.h>
 #include <pcl/segmentation/organized_connected_component_segmentation.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
+#include <atomic>
 #include <cstring>
 #include <limits>
 #include <map>
@@ -72,18 +76,24 @@ inline std::vector<int64_t> EceLabels(const pcl::PointCloud<pcl::PointXYZ>::Ptr&
 }
 
 // Reads every byte of the cloud once (an XOR of its 64-bit words, which
-// the compiler vectorizes), the least any pass over the scan can cost.
+// the compiler vectorizes), the least any pass over the scan can cost; in
+// 16 blocks over the calling arena's threads.
 inline void StreamOnce(const PointCloud& cloud) {
   const auto* bytes = reinterpret_cast<const unsigned char*>(cloud.points.data());
   const std::size_t n = cloud.size() * sizeof(Eigen::Vector3f) / 8;
-  uint64_t acc = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    uint64_t w;
-    std::memcpy(&w, bytes + 8 * i, 8);
-    acc ^= w;
-  }
+  std::atomic<uint64_t> all{0};
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, n / 16 + 1),
+                    [&](const tbb::blocked_range<std::size_t>& block) {
+                      uint64_t acc = 0;
+                      for (std::size_t i = block.begin(); i != block.end(); ++i) {
+                        uint64_t w;
+                        std::memcpy(&w, bytes + 8 * i, 8);
+                        acc ^= w;
+                      }
+                      all ^= acc;
+                    });
   static volatile uint64_t sink;
-  sink = acc;
+  sink = all.load();
 }
 
 }  // namespace clustering_detail
@@ -110,6 +120,12 @@ inline void AddClusteringRows(std::vector<Row>& rows) {
   pcl::OrganizedConnectedComponentSegmentation<pcl::PointXYZ, pcl::Label> seg(comparator);
   seg.setInputCloud(pcl_scan);
   pcl::PointCloud<pcl::Label> pcl_labels;
+  // Ours on one core too: the 5 ms goal is per core.
+  tbb::task_arena one_core(1);
+  double ours8_one = 0;
+  one_core.execute([&] {
+    ours8_one = MedianSeconds(21, true, [&] { (void)ClusterLinksOrganized(scan, settings, r8); });
+  });
   const auto [ours8, pcl_org] = MedianSecondsInterleaved(
       21, true, [&] { (void)ClusterLinksOrganized(scan, settings, r8); },
       [&] {
@@ -133,24 +149,31 @@ inline void AddClusteringRows(std::vector<Row>& rows) {
   const double ratio_scan = faster_pcl / ours8;
   // Two goals on this row: the absolute time and the ratio to
   // the faster of the two PCL methods (measured here, not assumed).
-  const bool fast = ours8 <= 5e-3, far_ahead = ratio_scan >= 20;
+  const bool fast = ours8_one <= 5e-3, far_ahead = ratio_scan >= 20;
   rows.push_back(
-      {"Link clustering, 1024x768 organized scan (ours: grid, 8-nb, 1 core)", Time(ours8),
+      {"Link clustering, 1024x768 organized scan (ours: grid, 8-nb, 2 threads)",
+       Time(ours8) + " (1 core: " + Time(ours8_one) + ")",
        Time(pcl_org) + " (PCL OrganizedConnectedComponentSegmentation, 4-nb)",
        Fmt("%.1fx", pcl_org / ours8),
        "ours 4-nb (" + Time(ours4) + ") vs PCL: " + AgreementText(diff_org, r4.valid_points),
        "≤ 5 ms on one core; ≥ 20x the faster PCL method",
-       Verdict(fast) + " (" + Time(ours8) + "); " + Verdict(far_ahead) +
+       Verdict(fast) + " (" + Time(ours8_one) + "); " + Verdict(far_ahead) +
            Fmt(" (%.1fx)", ratio_scan)});
   // The memory floor: every byte of the scan read once, in the same state
-  // of the caches as the runs above (warm, repeated).
+  // of the caches as the runs above (warm, repeated), with the threads ours
+  // had, and on one core.
   const double floor = MedianSeconds(31, true, [&] { StreamOnce(scan); });
-  rows.push_back({"Link clustering, the same organized scan, against the memory floor", Time(ours8),
-                  Time(floor) + " (read the 9.4 MB scan once, 1 core)", Fmt("%.1fx", floor / ours8),
-                  "ours / floor " + Fmt("%.1f", ours8 / floor),
-                  "≤ 4x the floor; ≥ 8x PCL's organized method",
-                  Verdict(ours8 <= 4 * floor) + Fmt(" (%.1fx)", ours8 / floor) + "; " +
-                      Verdict(pcl_org / ours8 >= 8) + Fmt(" (%.1fx)", pcl_org / ours8)});
+  double floor_one = 0;
+  one_core.execute([&] { floor_one = MedianSeconds(31, true, [&] { StreamOnce(scan); }); });
+  rows.push_back(
+      {"Link clustering, the same organized scan, against the memory floor", Time(ours8),
+       Time(floor) + " (read the 9.4 MB scan once, 2 threads; 1 core: " + Time(floor_one) + ")",
+       Fmt("%.1fx", floor / ours8),
+       "ours / floor " + Fmt("%.1f", ours8 / floor) +
+           " (1 core each: " + Fmt("%.1f", ours8_one / floor_one) + ")",
+       "≤ 4x the floor; ≥ 8x PCL's organized method",
+       Verdict(ours8 <= 4 * floor) + Fmt(" (%.1fx)", ours8 / floor) + "; " +
+           Verdict(pcl_org / ours8 >= 8) + Fmt(" (%.1fx)", pcl_org / ours8)});
   rows.push_back({"Link clustering, the same scan's valid points, unorganized",
                   Time(ours8) + " (grid path)",
                   Time(pcl_ece_scan) + " (PCL EuclideanClusterExtraction, kd-tree build included)",

@@ -1,5 +1,8 @@
 #include "core/filter/link_clustering_grid.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -14,11 +17,15 @@
 namespace surfinspect {
 namespace {
 
+using link_row::kNone;
+using link_row::NextBit;
 using link_row::RowMasks;
 using link_row::RowSoA;
 
 constexpr int32_t kInvalid = LinkClusteringResult::kInvalid;
-constexpr uint32_t kNone = UINT32_MAX;
+// Rows per band: bands are labelled in parallel and joined at their seams,
+// and their size does not depend on the thread count.
+constexpr uint32_t kBandRows = 64;
 
 // A maximal chain of west-linked valid pixels in one row, with its 3D bounds.
 struct Run {
@@ -27,18 +34,6 @@ struct Run {
   Eigen::Map<const Eigen::Vector3f> min() const { return Eigen::Map<const Eigen::Vector3f>(lo); }
   Eigen::Map<const Eigen::Vector3f> max() const { return Eigen::Map<const Eigen::Vector3f>(hi); }
 };
-
-// First set bit at index >= from, or kNone.
-uint32_t NextBit(const uint64_t* bits, uint32_t words, uint32_t from) {
-  uint32_t k = from / 64;
-  if (k >= words) return kNone;
-  uint64_t w = bits[k] & (~uint64_t{0} << (from % 64));
-  while (w == 0) {
-    if (++k == words) return kNone;
-    w = bits[k];
-  }
-  return 64 * k + static_cast<uint32_t>(__builtin_ctzll(w));
-}
 
 // Pass-1 state: two rows of structure-of-arrays and of run ids (this row
 // and the one above), the link masks of the current row, and the runs with
@@ -67,36 +62,22 @@ struct GridScratch {
   UnionFind forest;  // over run indices
 };
 
-// Run starts (valid, not west-linked) and ends (valid, next pixel not
-// west-linked) of the current row, from its masks.
-void FindRunBounds(GridScratch& g) {
-  const RowMasks m = g.m();
-  uint64_t* starts = g.starts();
-  uint64_t* ends = g.ends();
-  for (uint32_t k = 0; k < g.words; ++k) {
-    const uint64_t west_of_next = (m.west[k] >> 1) | (k + 1 < g.words ? m.west[k + 1] << 63 : 0);
-    starts[k] = m.valid[k] & ~m.west[k];
-    ends[k] = m.valid[k] & ~west_of_next;
-  }
-}
-
-// Merges run `id` (columns s..e of this row) with every run above that one
-// of its pixels links to along the masks' north-west, north and north-east.
-void MergeWithRunsAbove(GridScratch& g, int32_t id, uint32_t s, uint32_t e, uint32_t width,
-                        bool eight, const std::vector<int32_t>& run_above) {
-  const RowMasks m = g.m();
-  const uint64_t* const vertical[3] = {m.north_west, m.north, m.north_east};
+// Merges run `id` (columns s..e of its row) with every run above that one
+// of its pixels links to along the row's north-west, north and north-east
+// masks; run_above[c] + offset is the run of column c in the row above.
+void MergeWithRunsAbove(const uint64_t* const vertical[3], uint32_t words, int32_t id, uint32_t s,
+                        uint32_t e, uint32_t width, bool eight, const int32_t* run_above,
+                        int32_t offset, const std::vector<Run>& runs, UnionFind& forest) {
   const int offsets[3] = {-1, 0, 1};  // north-west, north, north-east
   const bool use[3] = {eight, true, eight};
   for (int k = 0; k < 3; ++k) {
     if (!use[k]) continue;
     // All pixels up to the end of a run above (shifted by the offset)
     // reach that same run: merge once, then skip past it.
-    for (uint32_t c = NextBit(vertical[k], g.words, s); c <= e;
-         c = NextBit(vertical[k], g.words, c)) {
-      const int32_t run_up = run_above[c + offsets[k]];
-      g.forest.Union(id, run_up);
-      const int64_t past = int64_t{g.runs[run_up].last_col} - offsets[k] + 1;
+    for (uint32_t c = NextBit(vertical[k], words, s); c <= e; c = NextBit(vertical[k], words, c)) {
+      const int32_t run_up = run_above[c + offsets[k]] + offset;
+      forest.Union(id, run_up);
+      const int64_t past = int64_t{runs[run_up].last_col} - offsets[k] + 1;
       c = static_cast<uint32_t>(std::max<int64_t>(c + 1, past));
       if (c >= width) break;
     }
@@ -104,8 +85,11 @@ void MergeWithRunsAbove(GridScratch& g, int32_t id, uint32_t s, uint32_t e, uint
 }
 
 // Pass 1 for row r: transposes it, computes its link masks, appends its runs
-// and merges them with the linked runs of the row above.
-absl::Status LabelRow(const PointCloud& cloud, uint32_t r, float r2, bool eight, GridScratch& g) {
+// and, unless r is its band's first row, merges them with the linked runs of
+// the row above. A band's first row below another keeps its vertical masks
+// for the join instead (`seam`, 3 * words).
+absl::Status LabelRow(const PointCloud& cloud, uint32_t r, uint32_t band_first, float r2,
+                      bool eight, GridScratch& g, std::vector<uint64_t>& seam) {
   const uint32_t w = cloud.width, h = cloud.height;
   RowSoA& cur = g.rows[r & 1];
   const RowSoA& up = g.rows[(r + 1) & 1];
@@ -121,7 +105,12 @@ absl::Status LabelRow(const PointCloud& cloud, uint32_t r, float r2, bool eight,
   if (link_row::ComputeMasks(cur, above ? &up : nullptr, eight, g.words, r2, g.m()))
     return absl::InvalidArgumentError(
         absl::StrCat("link clustering: row ", r, " holds an infinite coordinate"));
-  FindRunBounds(g);
+  const RowMasks m = g.m();
+  const uint64_t* const vertical[3] = {m.north_west, m.north, m.north_east};
+  const bool merge = above && r > band_first;
+  if (above && !merge)
+    for (int k = 0; k < 3; ++k) std::copy(vertical[k], vertical[k] + g.words, &seam[k * g.words]);
+  link_row::RunBounds(m, g.words, g.starts(), g.ends());
   const uint64_t* starts = g.starts();
   const uint64_t* ends = g.ends();
   std::vector<int32_t>& run_here = g.run_of[r & 1];
@@ -132,20 +121,83 @@ absl::Status LabelRow(const PointCloud& cloud, uint32_t r, float r2, bool eight,
     g.runs.push_back({r, s, e, {0, 0, 0}, {0, 0, 0}});
     link_row::Bounds(cur, s, e, g.runs.back().lo, g.runs.back().hi);
     std::fill(run_here.begin() + s, run_here.begin() + e + 1, id);
-    if (above) MergeWithRunsAbove(g, id, s, e, w, eight, run_above);
+    if (merge)
+      MergeWithRunsAbove(vertical, g.words, id, s, e, w, eight, run_above.data(), 0, g.runs,
+                         g.forest);
   }
   return absl::OkStatus();
 }
 
+// Rows [first, end) labelled apart from the others: their runs, the
+// union-find over them (band-local indices), the run of each column in the
+// last row, and the first row's vertical masks and run count for the join.
+struct Band {
+  uint32_t first = 0, end = 0;
+  std::vector<Run> runs;
+  UnionFind forest;
+  std::vector<int32_t> last_row_runs;
+  std::vector<uint64_t> seam;
+  std::size_t first_row_runs = 0;
+  std::size_t offset = 0;  // of its first run among all, set by the join
+  absl::Status status;
+};
+
+void LabelBand(const PointCloud& cloud, float r2, bool eight, const std::atomic<bool>* cancel,
+               Band& band) {
+  GridScratch g(cloud.width, band.end - band.first);
+  band.seam.assign(3 * std::size_t{g.words}, 0);
+  // The row above the band, for the first row's vertical masks.
+  if (band.first > 0)
+    link_row::Transpose(&cloud.points[std::size_t{band.first - 1} * cloud.width], cloud.width,
+                        g.rows[(band.first - 1) & 1]);
+  for (uint32_t r = band.first; r < band.end; ++r) {
+    if (IsCancelled(cancel)) {
+      band.status = absl::CancelledError("link clustering: cancelled");
+      return;
+    }
+    band.status = LabelRow(cloud, r, band.first, r2, eight, g, band.seam);
+    if (!band.status.ok()) return;
+    if (r == band.first) band.first_row_runs = g.runs.size();
+  }
+  band.runs = std::move(g.runs);
+  band.forest = std::move(g.forest);
+  band.last_row_runs = std::move(g.run_of[(band.end - 1) & 1]);
+}
+
+// Concatenates the bands' runs and forests in row order and merges each
+// band's first row with the last row of the band above. Union by smaller
+// root keeps every root the lowest run of its component, so the result is
+// the forest of one serial pass whatever the bands.
+void JoinBands(std::vector<Band>& bands, uint32_t width, bool eight, std::vector<Run>& runs,
+               UnionFind& forest) {
+  const uint32_t words = (width + 63) / 64;
+  int32_t above_offset = 0;
+  for (std::size_t b = 0; b < bands.size(); ++b) {
+    const auto offset = static_cast<int32_t>(runs.size());
+    bands[b].offset = runs.size();
+    runs.insert(runs.end(), bands[b].runs.begin(), bands[b].runs.end());
+    forest.Append(bands[b].forest);
+    if (b > 0) {
+      const uint64_t* const vertical[3] = {&bands[b].seam[0], &bands[b].seam[words],
+                                           &bands[b].seam[2 * std::size_t{words}]};
+      for (std::size_t i = 0; i < bands[b].first_row_runs; ++i) {
+        const Run& run = runs[offset + i];
+        MergeWithRunsAbove(vertical, words, offset + static_cast<int32_t>(i), run.first_col,
+                           run.last_col, width, eight, bands[b - 1].last_row_runs.data(),
+                           above_offset, runs, forest);
+      }
+    }
+    above_offset = offset;
+  }
+}
+
 // Pass 2: ids in raster order of each component's first run (parent[r] <=
-// r, so the entry r points to already holds its final id), statistics, and
-// labels written as spans. On return parent[i] is run i's component id.
-void NumberComponents(const std::vector<Run>& runs, std::vector<int32_t>& parent, uint32_t width,
+// r, so the entry r points to already holds its final id) and statistics.
+// On return parent[i] is run i's component id.
+void NumberComponents(const std::vector<Run>& runs, std::vector<int32_t>& parent,
                       LinkClusteringResult& result) {
   auto& clusters = result.clusters;
   clusters.clear();
-  int32_t* labels = result.labels.data();
-  std::size_t cursor = 0;
   for (std::size_t i = 0; i < runs.size(); ++i) {
     const Run& run = runs[i];
     int32_t id;
@@ -169,24 +221,29 @@ void NumberComponents(const std::vector<Run>& runs, std::vector<int32_t>& parent
     k.max_col = std::max(k.max_col, run.last_col);
     k.min = k.min.cwiseMin(run.min());
     k.max = k.max.cwiseMax(run.max());
-    const std::size_t first = std::size_t{run.row} * width + run.first_col;
-    const std::size_t last = std::size_t{run.row} * width + run.last_col;
-    std::fill(labels + cursor, labels + first, kInvalid);
-    std::fill(labels + first, labels + last + 1, id);
-    cursor = last + 1;
   }
-  std::fill(labels + cursor, labels + result.labels.size(), kInvalid);
 }
 
-// Pass 3: the kept mask, written as spans of the kept runs.
-void FillKeptMask(const std::vector<Run>& runs, const std::vector<int32_t>& component,
-                  uint32_t width, LinkClusteringResult& result) {
-  result.kept_mask.assign(result.labels.size(), 0);
-  for (std::size_t i = 0; i < runs.size(); ++i)
-    if (result.clusters[static_cast<std::size_t>(component[i])].kept) {
-      const std::size_t first = std::size_t{runs[i].row} * width + runs[i].first_col;
-      std::memset(result.kept_mask.data() + first, 1, runs[i].last_col - runs[i].first_col + 1);
-    }
+// Pass 3: one band's labels and kept mask, written as spans of its runs.
+void WriteBand(const Band& band, const std::vector<Run>& runs,
+               const std::vector<int32_t>& component, uint32_t width,
+               LinkClusteringResult& result) {
+  int32_t* labels = result.labels.data();
+  uint8_t* mask = result.kept_mask.data();
+  std::size_t cursor = std::size_t{band.first} * width;
+  for (std::size_t i = band.offset; i < band.offset + band.runs.size(); ++i) {
+    const std::size_t first = std::size_t{runs[i].row} * width + runs[i].first_col;
+    const std::size_t end = first + runs[i].last_col - runs[i].first_col + 1;
+    const int32_t id = component[i];
+    std::fill(labels + cursor, labels + first, kInvalid);
+    std::fill(labels + first, labels + end, id);
+    std::memset(mask + cursor, 0, first - cursor);
+    std::memset(mask + first, result.clusters[static_cast<std::size_t>(id)].kept, end - first);
+    cursor = end;
+  }
+  const std::size_t band_end = std::size_t{band.end} * width;
+  std::fill(labels + cursor, labels + band_end, kInvalid);
+  std::memset(mask + cursor, 0, band_end - cursor);
 }
 
 }  // namespace
@@ -196,18 +253,32 @@ absl::Status ClusterLinksOrganized(const PointCloud& cloud, const LinkClustering
   if (auto st = internal::CheckInput(cloud, settings); !st.ok()) return st;
   const float r2 = LinkDistanceSquared(settings.link_distance_mm);
   const bool eight = settings.connectivity == 8;
-  GridScratch g(cloud.width, cloud.height);
-  for (uint32_t r = 0; r < cloud.height; ++r) {
-    if (IsCancelled(cancel)) return absl::CancelledError("link clustering: cancelled");
-    if (auto st = LabelRow(cloud, r, r2, eight, g); !st.ok()) return st;
+  std::vector<Band> bands((cloud.height + kBandRows - 1) / kBandRows);
+  for (std::size_t b = 0; b < bands.size(); ++b) {
+    bands[b].first = static_cast<uint32_t>(b * kBandRows);
+    bands[b].end = std::min(cloud.height, static_cast<uint32_t>((b + 1) * kBandRows));
   }
+  auto each_band = [&bands](auto&& work) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, bands.size(), 1),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        for (std::size_t b = range.begin(); b != range.end(); ++b) work(bands[b]);
+                      });
+  };
+  each_band([&](Band& band) { LabelBand(cloud, r2, eight, cancel, band); });
+  // The first failing band in row order has the first failing row.
+  for (const Band& band : bands)
+    if (!band.status.ok()) return band.status;
+  std::vector<Run> runs;
+  UnionFind forest;
+  JoinBands(bands, cloud.width, eight, runs, forest);
   result.input_points = cloud.size();
   result.organized_path = true;
   result.labels.resize(cloud.size());
-  std::vector<int32_t> component = std::move(g.forest).ReleaseParents();
-  NumberComponents(g.runs, component, cloud.width, result);
+  result.kept_mask.resize(cloud.size());
+  std::vector<int32_t> component = std::move(forest).ReleaseParents();
+  NumberComponents(runs, component, result);
   internal::DecideClusters(settings, result);
-  FillKeptMask(g.runs, component, cloud.width, result);
+  each_band([&](Band& band) { WriteBand(band, runs, component, cloud.width, result); });
   return absl::OkStatus();
 }
 

@@ -9,9 +9,12 @@
 // instruction. A run is a maximal chain of west-linked pixels; runs are the
 // union-find elements, and the north links of a run are visited once per
 // touching run above (bit scans skip the rest), so the per-pixel work is a
-// handful of vector instructions. The second pass walks the runs in raster
-// order, numbers the components and writes labels and the kept mask as
-// filled spans. No per-point heap allocation; scratch is O(width + runs).
+// handful of vector instructions. Bands of 64 rows are labelled in parallel
+// and joined where each band's first row meets the row above it; the union
+// makes the smaller run the root, so the forest is the serial pass's. The
+// second pass walks the runs in raster order and numbers the components;
+// the third writes labels and the kept mask as filled spans, band by band
+// in parallel. No per-point heap allocation; scratch is O(width + runs).
 #pragma once
 
 #include <atomic>
@@ -23,7 +26,8 @@
 namespace surfinspect {
 
 // Grid path on an organized cloud (height == 1 is accepted as one row).
-// Errors as ClusterLinks.
+// Errors as ClusterLinks. Runs on the calling TBB arena's threads; the
+// result does not depend on their number.
 absl::Status ClusterLinksOrganized(const PointCloud& cloud, const LinkClusteringSettings& settings,
                                    LinkClusteringResult& result,
                                    const std::atomic<bool>* cancel = nullptr);

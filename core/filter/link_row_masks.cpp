@@ -133,6 +133,25 @@ bool ComputeMasks(const RowSoA& cur, const RowSoA* up, bool diagonals, uint32_t 
   return RowBits<true, false>(cur, *up, words, link_distance_sq, masks);
 }
 
+void RunBounds(const RowMasks& m, uint32_t words, uint64_t* starts, uint64_t* ends) {
+  for (uint32_t k = 0; k < words; ++k) {
+    const uint64_t west_of_next = (m.west[k] >> 1) | (k + 1 < words ? m.west[k + 1] << 63 : 0);
+    starts[k] = m.valid[k] & ~m.west[k];
+    ends[k] = m.valid[k] & ~west_of_next;
+  }
+}
+
+uint32_t NextBit(const uint64_t* bits, uint32_t words, uint32_t from) {
+  uint32_t k = from / 64;
+  if (k >= words) return kNone;
+  uint64_t w = bits[k] & (~uint64_t{0} << (from % 64));
+  while (w == 0) {
+    if (++k == words) return kNone;
+    w = bits[k];
+  }
+  return 64 * k + static_cast<uint32_t>(__builtin_ctzll(w));
+}
+
 // Bounds of the (all valid) pixels first..last of the row.
 void Bounds(const RowSoA& row, uint32_t first, uint32_t last, float lo_out[3], float hi_out[3]) {
   for (int a = 0; a < 3; ++a) {

@@ -47,6 +47,14 @@ bool RowIsaSupported(RowIsa isa);
 bool ComputeMasks(const RowSoA& cur, const RowSoA* up, bool diagonals, uint32_t words,
                   float link_distance_sq, const RowMasks& masks, RowIsa isa = RowIsa::kAuto);
 
+// Run starts (valid, not west-linked) and ends (valid, the next pixel not
+// west-linked) of a row, from its valid and west masks.
+void RunBounds(const RowMasks& m, uint32_t words, uint64_t* starts, uint64_t* ends);
+
+// The first set bit at index >= from in `words` mask words, or kNone.
+constexpr uint32_t kNone = UINT32_MAX;
+uint32_t NextBit(const uint64_t* bits, uint32_t words, uint32_t from);
+
 // Bounds of the pixels first..last of the row, which must all be valid.
 void Bounds(const RowSoA& row, uint32_t first, uint32_t last, float lo[3], float hi[3]);
 

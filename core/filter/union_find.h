@@ -50,6 +50,9 @@ class UnionFind {
     b = Find(b);
     return a == b ? a : LinkRoots(a, b);
   }
+  // Appends `other`'s elements as size() + i, with their links: a forest
+  // built apart (a band of rows, say) joins this one, parent(i) <= i kept.
+  void Append(const UnionFind& other);
   // The parent array (parent[i] <= i), e.g. to relabel in place.
   std::vector<int32_t> ReleaseParents() && { return std::move(parent_); }
 

@@ -249,6 +249,59 @@ TEST(LinkClusteringGrid, SnakesAndSpiralsNeedManyMerges) {
   }
 }
 
+// Ids count up in raster order of each component's first point.
+void ExpectRasterNumbering(const std::vector<int32_t>& labels) {
+  int32_t next = 0;
+  for (std::size_t i = 0; i < labels.size(); ++i) {
+    if (labels[i] == kInvalid || labels[i] < next) continue;
+    ASSERT_EQ(labels[i], next) << "point " << i << " starts a component out of raster order";
+    ++next;
+  }
+}
+
+TEST(LinkClusteringGrid, TallGridsJoinTheirBandsAtTheSeams) {
+  // Rows are labelled in bands of 64 and the bands joined: components that
+  // cross one or several seams, and seams through holes, must come out as
+  // one serial pass would number them.
+  std::mt19937 rng(23);
+  std::uniform_int_distribution<uint32_t> width(1, 90), height(60, 300);
+  for (int trial = 0; trial < 40; ++trial) {
+    const uint32_t w = width(rng), h = height(rng);
+    const PointCloud c = RandomGrid(rng, w, h, trial % 3 == 0 ? 0.0 : 0.15);
+    for (int conn : {4, 8}) {
+      LinkClusteringSettings s = HalfMm();
+      s.connectivity = conn;
+      s.min_cluster_points = 1 + trial % 5;
+      auto r = ClusterLinks(c, s);
+      ASSERT_TRUE(r.ok()) << r.status();
+      SCOPED_TRACE(testing::Message()
+                   << "trial " << trial << " " << w << "x" << h << " conn " << conn);
+      ExpectSamePartition(r->labels, GridOracle(c, conn, LinkDistanceSquared(0.5)));
+      ExpectRasterNumbering(r->labels);
+      ExpectConsistent(c, *r, s);
+      if (HasFatalFailure()) return;
+    }
+  }
+  // A comb whose teeth run through four bands and join only at the top or
+  // the bottom: one component, built almost wholly from seam merges.
+  for (int conn : {4, 8}) {
+    const uint32_t w = 21, h = 250;
+    PointCloud c = PointCloud::Organized(w, h);
+    for (uint32_t r = 0; r < h; ++r)
+      for (uint32_t col = 0; col < w; ++col) {
+        const bool on = (col % 2 == 0) || (r == (col % 4 == 1 ? h - 1 : 0));
+        c.points[r * w + col] = {0.3f * col, 0.3f * r, on ? 0.f : 5.f + 7.f * ((r + col) % 2)};
+      }
+    LinkClusteringSettings s = HalfMm();
+    s.connectivity = conn;
+    auto r = ClusterLinks(c, s);
+    ASSERT_TRUE(r.ok());
+    ExpectSamePartition(r->labels, GridOracle(c, conn, LinkDistanceSquared(0.5)));
+    ExpectRasterNumbering(r->labels);
+    EXPECT_EQ(r->largest_cluster, (w / 2 + 1) * h + w / 2);
+  }
+}
+
 TEST(LinkClusteringGrid, SingleRowAndSingleColumn) {
   std::mt19937 rng(3);
   for (auto [w, h] : {std::pair<uint32_t, uint32_t>{50, 1}, {1, 50}, {1, 2}}) {

@@ -108,6 +108,32 @@ TEST_P(LinkRowMasks, FirstRowHasNoVerticalLinksAndInfinityIsReported) {
   EXPECT_TRUE(ComputeMasks(row, nullptr, true, 2, 0.25f, m, GetParam()));
 }
 
+// Starts and ends against their per-pixel definitions, across words, and
+// the bit scan against a linear search.
+TEST(LinkRowRuns, StartsEndsAndNextBitMatchTheirDefinitions) {
+  std::mt19937_64 rng(8);
+  for (uint32_t words : {1u, 2u, 5u}) {
+    std::vector<uint64_t> valid(words), west(words), starts(words), ends(words);
+    for (uint32_t k = 0; k < words; ++k) {
+      valid[k] = rng() | rng();  // mostly valid, so runs cross words
+      west[k] = valid[k] & (rng() | rng()) & (valid[k] << 1 | (k > 0 ? valid[k - 1] >> 63 : 0));
+    }
+    const RowMasks m{valid.data(), west.data(), nullptr, nullptr, nullptr};
+    RunBounds(m, words, starts.data(), ends.data());
+    const uint32_t n = 64 * words;
+    for (uint32_t i = 0; i < n; ++i) {
+      const bool next_west = i + 1 < n && Bit(west, i + 1);
+      ASSERT_EQ(Bit(starts, i), Bit(valid, i) && !Bit(west, i)) << i;
+      ASSERT_EQ(Bit(ends, i), Bit(valid, i) && !next_west) << i;
+      uint32_t want = kNone;
+      for (uint32_t j = i; j < n && want == kNone; ++j)
+        if (Bit(starts, j)) want = j;
+      ASSERT_EQ(NextBit(starts.data(), words, i), want) << i;
+    }
+    EXPECT_EQ(NextBit(starts.data(), words, n), kNone);
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(EachIsa, LinkRowMasks, ::testing::Values(RowIsa::kSse2, RowIsa::kAvx2),
                          [](const ::testing::TestParamInfo<RowIsa>& i) {
                            return i.param == RowIsa::kAvx2 ? std::string("Avx2")

@@ -77,5 +77,31 @@ TEST(UnionFind, LinkRootsReturnsTheSmallerRoot) {
   EXPECT_EQ(uf.Union(2, 2), 2);
 }
 
+// Forests built apart and appended, then joined by unions across them,
+// give the sets (and roots) of one forest built with all the unions.
+TEST(UnionFind, AppendedForestsJoinAsOne) {
+  std::mt19937 rng(12);
+  const int sizes[3] = {40, 1, 25};
+  UnionFind whole(66), joined;
+  int offset = 0;
+  for (int n : sizes) {
+    UnionFind part(static_cast<std::size_t>(n));
+    for (int k = 0; k < n / 2; ++k) {
+      const auto a = static_cast<int32_t>(rng() % n), b = static_cast<int32_t>(rng() % n);
+      part.Union(a, b);
+      whole.Union(a + offset, b + offset);
+    }
+    joined.Append(part);
+    offset += n;
+  }
+  ASSERT_EQ(joined.size(), 66u);
+  for (int k = 0; k < 10; ++k) {
+    const auto a = static_cast<int32_t>(rng() % 66), b = static_cast<int32_t>(rng() % 66);
+    whole.Union(a, b);
+    joined.Union(a, b);
+  }
+  for (int32_t i = 0; i < 66; ++i) ASSERT_EQ(joined.Find(i), whole.Find(i)) << i;
+}
+
 }  // namespace
 }  // namespace surfinspect
