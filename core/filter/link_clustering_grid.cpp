@@ -44,8 +44,9 @@ struct GridScratch {
         rows{RowSoA(64 * words), RowSoA(64 * words)},
         masks(7 * std::size_t{words}),
         run_of{std::vector<int32_t>(width), std::vector<int32_t>(width)} {
-    runs.reserve(4 * std::size_t{height});
-    forest.Reserve(4 * std::size_t{height});
+    // The demo scan has about 30 runs a row; the reserve avoids regrowing.
+    runs.reserve(32 * std::size_t{height});
+    forest.Reserve(32 * std::size_t{height});
   }
   const uint32_t words;
   RowSoA rows[2];
@@ -64,10 +65,11 @@ struct GridScratch {
 
 // Merges run `id` (columns s..e of its row) with every run above that one
 // of its pixels links to along the row's north-west, north and north-east
-// masks; run_above[c] + offset is the run of column c in the row above.
+// masks. run_above[c] is the run of column c in the row above, an index
+// into `above` and, plus `offset`, into the forest.
 void MergeWithRunsAbove(const uint64_t* const vertical[3], uint32_t words, int32_t id, uint32_t s,
                         uint32_t e, uint32_t width, bool eight, const int32_t* run_above,
-                        int32_t offset, const std::vector<Run>& runs, UnionFind& forest) {
+                        const Run* above, int32_t offset, UnionFind& forest) {
   const int offsets[3] = {-1, 0, 1};  // north-west, north, north-east
   const bool use[3] = {eight, true, eight};
   for (int k = 0; k < 3; ++k) {
@@ -75,9 +77,9 @@ void MergeWithRunsAbove(const uint64_t* const vertical[3], uint32_t words, int32
     // All pixels up to the end of a run above (shifted by the offset)
     // reach that same run: merge once, then skip past it.
     for (uint32_t c = NextBit(vertical[k], words, s); c <= e; c = NextBit(vertical[k], words, c)) {
-      const int32_t run_up = run_above[c + offsets[k]] + offset;
-      forest.Union(id, run_up);
-      const int64_t past = int64_t{runs[run_up].last_col} - offsets[k] + 1;
+      const int32_t run_up = run_above[c + offsets[k]];
+      forest.Union(id, run_up + offset);
+      const int64_t past = int64_t{above[run_up].last_col} - offsets[k] + 1;
       c = static_cast<uint32_t>(std::max<int64_t>(c + 1, past));
       if (c >= width) break;
     }
@@ -122,7 +124,7 @@ absl::Status LabelRow(const PointCloud& cloud, uint32_t r, uint32_t band_first, 
     link_row::Bounds(cur, s, e, g.runs.back().lo, g.runs.back().hi);
     std::fill(run_here.begin() + s, run_here.begin() + e + 1, id);
     if (merge)
-      MergeWithRunsAbove(vertical, g.words, id, s, e, w, eight, run_above.data(), 0, g.runs,
+      MergeWithRunsAbove(vertical, g.words, id, s, e, w, eight, run_above.data(), g.runs.data(), 0,
                          g.forest);
   }
   return absl::OkStatus();
@@ -164,77 +166,76 @@ void LabelBand(const PointCloud& cloud, float r2, bool eight, const std::atomic<
   band.last_row_runs = std::move(g.run_of[(band.end - 1) & 1]);
 }
 
-// Concatenates the bands' runs and forests in row order and merges each
-// band's first row with the last row of the band above. Union by smaller
-// root keeps every root the lowest run of its component, so the result is
-// the forest of one serial pass whatever the bands.
-void JoinBands(std::vector<Band>& bands, uint32_t width, bool eight, std::vector<Run>& runs,
-               UnionFind& forest) {
+// Concatenates the bands' forests in row order and merges each band's
+// first row with the last row of the band above. Union by smaller root
+// keeps every root the lowest run of its component, so the result is the
+// forest of one serial pass whatever the bands.
+UnionFind JoinBands(std::vector<Band>& bands, uint32_t width, bool eight) {
   const uint32_t words = (width + 63) / 64;
-  int32_t above_offset = 0;
+  UnionFind forest;
   for (std::size_t b = 0; b < bands.size(); ++b) {
-    const auto offset = static_cast<int32_t>(runs.size());
-    bands[b].offset = runs.size();
-    runs.insert(runs.end(), bands[b].runs.begin(), bands[b].runs.end());
-    forest.Append(bands[b].forest);
-    if (b > 0) {
-      const uint64_t* const vertical[3] = {&bands[b].seam[0], &bands[b].seam[words],
-                                           &bands[b].seam[2 * std::size_t{words}]};
-      for (std::size_t i = 0; i < bands[b].first_row_runs; ++i) {
-        const Run& run = runs[offset + i];
-        MergeWithRunsAbove(vertical, words, offset + static_cast<int32_t>(i), run.first_col,
-                           run.last_col, width, eight, bands[b - 1].last_row_runs.data(),
-                           above_offset, runs, forest);
-      }
-    }
-    above_offset = offset;
+    Band& band = bands[b];
+    band.offset = forest.size();
+    forest.Append(band.forest);
+    if (b == 0) continue;
+    const uint64_t* const vertical[3] = {&band.seam[0], &band.seam[words],
+                                         &band.seam[2 * std::size_t{words}]};
+    const Band& above = bands[b - 1];
+    for (std::size_t i = 0; i < band.first_row_runs; ++i)
+      MergeWithRunsAbove(vertical, words, static_cast<int32_t>(band.offset + i),
+                         band.runs[i].first_col, band.runs[i].last_col, width, eight,
+                         above.last_row_runs.data(), above.runs.data(),
+                         static_cast<int32_t>(above.offset), forest);
   }
+  return forest;
 }
 
 // Pass 2: ids in raster order of each component's first run (parent[r] <=
 // r, so the entry r points to already holds its final id) and statistics.
 // On return parent[i] is run i's component id.
-void NumberComponents(const std::vector<Run>& runs, std::vector<int32_t>& parent,
+void NumberComponents(const std::vector<Band>& bands, std::vector<int32_t>& parent,
                       LinkClusteringResult& result) {
   auto& clusters = result.clusters;
   clusters.clear();
-  for (std::size_t i = 0; i < runs.size(); ++i) {
-    const Run& run = runs[i];
-    int32_t id;
-    if (parent[i] == static_cast<int32_t>(i)) {
-      id = static_cast<int32_t>(clusters.size());
-      ClusterInfo k;
-      k.min_row = k.max_row = run.row;
-      k.min_col = run.first_col;
-      k.max_col = run.last_col;
-      k.min = run.min();
-      k.max = run.max();
-      clusters.push_back(k);
-    } else {
-      id = parent[parent[i]];
+  std::size_t i = 0;
+  for (const Band& band : bands)
+    for (const Run& run : band.runs) {
+      int32_t id;
+      if (parent[i] == static_cast<int32_t>(i)) {
+        id = static_cast<int32_t>(clusters.size());
+        ClusterInfo k;
+        k.min_row = k.max_row = run.row;
+        k.min_col = run.first_col;
+        k.max_col = run.last_col;
+        k.min = run.min();
+        k.max = run.max();
+        clusters.push_back(k);
+      } else {
+        id = parent[parent[i]];
+      }
+      parent[i] = id;
+      ClusterInfo& k = clusters[static_cast<std::size_t>(id)];
+      k.size += run.last_col - run.first_col + 1;
+      k.max_row = run.row;
+      k.min_col = std::min(k.min_col, run.first_col);
+      k.max_col = std::max(k.max_col, run.last_col);
+      k.min = k.min.cwiseMin(run.min());
+      k.max = k.max.cwiseMax(run.max());
+      ++i;
     }
-    parent[i] = id;
-    ClusterInfo& k = clusters[static_cast<std::size_t>(id)];
-    k.size += run.last_col - run.first_col + 1;
-    k.max_row = run.row;
-    k.min_col = std::min(k.min_col, run.first_col);
-    k.max_col = std::max(k.max_col, run.last_col);
-    k.min = k.min.cwiseMin(run.min());
-    k.max = k.max.cwiseMax(run.max());
-  }
 }
 
 // Pass 3: one band's labels and kept mask, written as spans of its runs.
-void WriteBand(const Band& band, const std::vector<Run>& runs,
-               const std::vector<int32_t>& component, uint32_t width,
+void WriteBand(const Band& band, const std::vector<int32_t>& component, uint32_t width,
                LinkClusteringResult& result) {
   int32_t* labels = result.labels.data();
   uint8_t* mask = result.kept_mask.data();
   std::size_t cursor = std::size_t{band.first} * width;
-  for (std::size_t i = band.offset; i < band.offset + band.runs.size(); ++i) {
-    const std::size_t first = std::size_t{runs[i].row} * width + runs[i].first_col;
-    const std::size_t end = first + runs[i].last_col - runs[i].first_col + 1;
-    const int32_t id = component[i];
+  for (std::size_t i = 0; i < band.runs.size(); ++i) {
+    const Run& run = band.runs[i];
+    const std::size_t first = std::size_t{run.row} * width + run.first_col;
+    const std::size_t end = first + run.last_col - run.first_col + 1;
+    const int32_t id = component[band.offset + i];
     std::fill(labels + cursor, labels + first, kInvalid);
     std::fill(labels + first, labels + end, id);
     std::memset(mask + cursor, 0, first - cursor);
@@ -268,17 +269,15 @@ absl::Status ClusterLinksOrganized(const PointCloud& cloud, const LinkClustering
   // The first failing band in row order has the first failing row.
   for (const Band& band : bands)
     if (!band.status.ok()) return band.status;
-  std::vector<Run> runs;
-  UnionFind forest;
-  JoinBands(bands, cloud.width, eight, runs, forest);
+  UnionFind forest = JoinBands(bands, cloud.width, eight);
   result.input_points = cloud.size();
   result.organized_path = true;
   result.labels.resize(cloud.size());
   result.kept_mask.resize(cloud.size());
   std::vector<int32_t> component = std::move(forest).ReleaseParents();
-  NumberComponents(runs, component, result);
+  NumberComponents(bands, component, result);
   internal::DecideClusters(settings, result);
-  each_band([&](Band& band) { WriteBand(band, runs, component, cloud.width, result); });
+  each_band([&](Band& band) { WriteBand(band, component, cloud.width, result); });
   return absl::OkStatus();
 }
 

@@ -141,19 +141,18 @@ void RunBounds(const RowMasks& m, uint32_t words, uint64_t* starts, uint64_t* en
   }
 }
 
-uint32_t NextBit(const uint64_t* bits, uint32_t words, uint32_t from) {
-  uint32_t k = from / 64;
-  if (k >= words) return kNone;
-  uint64_t w = bits[k] & (~uint64_t{0} << (from % 64));
-  while (w == 0) {
-    if (++k == words) return kNone;
-    w = bits[k];
-  }
-  return 64 * k + static_cast<uint32_t>(__builtin_ctzll(w));
-}
-
 // Bounds of the (all valid) pixels first..last of the row.
 void Bounds(const RowSoA& row, uint32_t first, uint32_t last, float lo_out[3], float hi_out[3]) {
+  // Most runs of a scan are a few outlier pixels: one pass for all three axes.
+  if (last - first < 8) {
+    for (int a = 0; a < 3; ++a) lo_out[a] = hi_out[a] = row.c(a)[first];
+    for (uint32_t i = first + 1; i <= last; ++i)
+      for (int a = 0; a < 3; ++a) {
+        lo_out[a] = std::min(lo_out[a], row.c(a)[i]);
+        hi_out[a] = std::max(hi_out[a], row.c(a)[i]);
+      }
+    return;
+  }
   for (int a = 0; a < 3; ++a) {
     const float* v = row.c(a);
     uint32_t i = first;

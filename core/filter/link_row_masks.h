@@ -53,7 +53,16 @@ void RunBounds(const RowMasks& m, uint32_t words, uint64_t* starts, uint64_t* en
 
 // The first set bit at index >= from in `words` mask words, or kNone.
 constexpr uint32_t kNone = UINT32_MAX;
-uint32_t NextBit(const uint64_t* bits, uint32_t words, uint32_t from);
+inline uint32_t NextBit(const uint64_t* bits, uint32_t words, uint32_t from) {
+  uint32_t k = from / 64;
+  if (k >= words) return kNone;
+  uint64_t w = bits[k] & (~uint64_t{0} << (from % 64));
+  while (w == 0) {
+    if (++k == words) return kNone;
+    w = bits[k];
+  }
+  return 64 * k + static_cast<uint32_t>(__builtin_ctzll(w));
+}
 
 // Bounds of the pixels first..last of the row, which must all be valid.
 void Bounds(const RowSoA& row, uint32_t first, uint32_t last, float lo[3], float hi[3]);
