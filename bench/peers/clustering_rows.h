@@ -159,20 +159,23 @@ inline void AddClusteringRows(std::vector<Row>& rows) {
        "≤ 5 ms on one core; ≥ 20x the faster PCL method",
        Verdict(fast) + " (" + Time(ours8_one) + "); " + Verdict(far_ahead) +
            Fmt(" (%.1fx)", ratio_scan)});
-  // The memory floor: every byte of the scan read once, in the same state
-  // of the caches as the runs above (warm, repeated), with the threads ours
-  // had, and on one core.
+  // The memory floor: every byte of the scan read once, with the threads
+  // ours had and on one core. Both it and ours are timed warm and repeated
+  // here: interleaved with PCL above, ours starts with the scan out of cache.
   const double floor = MedianSeconds(31, true, [&] { StreamOnce(scan); });
+  const double ours8_warm =
+      MedianSeconds(31, true, [&] { (void)ClusterLinksOrganized(scan, settings, r8); });
   double floor_one = 0;
   one_core.execute([&] { floor_one = MedianSeconds(31, true, [&] { StreamOnce(scan); }); });
   rows.push_back(
-      {"Link clustering, the same organized scan, against the memory floor", Time(ours8),
+      {"Link clustering, the same organized scan, against the memory floor (both warm)",
+       Time(ours8_warm),
        Time(floor) + " (read the 9.4 MB scan once, 2 threads; 1 core: " + Time(floor_one) + ")",
-       Fmt("%.1fx", floor / ours8),
-       "ours / floor " + Fmt("%.1f", ours8 / floor) +
+       Fmt("%.1fx", floor / ours8_warm),
+       "ours / floor " + Fmt("%.1f", ours8_warm / floor) +
            " (1 core each: " + Fmt("%.1f", ours8_one / floor_one) + ")",
-       "≤ 4x the floor; ≥ 8x PCL's organized method",
-       Verdict(ours8 <= 4 * floor) + Fmt(" (%.1fx)", ours8 / floor) + "; " +
+       "≤ 4x the floor; ≥ 8x PCL's organized method (row above)",
+       Verdict(ours8_warm <= 4 * floor) + Fmt(" (%.1fx)", ours8_warm / floor) + "; " +
            Verdict(pcl_org / ours8 >= 8) + Fmt(" (%.1fx)", pcl_org / ours8)});
   rows.push_back({"Link clustering, the same scan's valid points, unorganized",
                   Time(ours8) + " (grid path)",

@@ -223,7 +223,7 @@ absl::StatusOr<WideBvh> WideBvh::Build(RTCDevice device, const TriangleMesh& mes
   args.buildQuality = quality;
   args.maxBranchingFactor = wide::kWidth;
   args.maxDepth = wide::kMaxDepth;
-  args.sahBlockSize = wide::kMaxLeafTriangles;  // a leaf of 4 costs as much as one of 1
+  args.sahBlockSize = wide::kMaxLeafTriangles;  // a leaf of 8 costs as much as one of 1
   args.minLeafSize = 1;
   args.maxLeafSize = wide::kMaxLeafTriangles;
   args.traversalCost = 1.0f;
@@ -275,8 +275,6 @@ void FillLeafLane(wide::LeafBlock& block, int lane, uint32_t t, const Eigen::Vec
   block.triangle[lane] = t;
   block.shape[lane] = static_cast<uint8_t>(shape);
 }
-
-float LeafMargin(const Eigen::Vector3d& p) { return RoundUpToFloat(8 * 0x1p-24 * p.lpNorm<1>()); }
 
 void LeafBounds2(SearchIsa isa, const wide::LeafBlock& block, const Eigen::Vector3d& p,
                  float out[wide::kLeafWidth]) {

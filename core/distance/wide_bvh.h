@@ -1,5 +1,5 @@
 // The mesh index's BVH: built by Embree (rtcBuildBVH, binned SAH or Morton,
-// 8 children per node, leaves of at most 4 triangles) and copied into our
+// 8 children per node, leaves of at most 8 triangles) and copied into our
 // own flat layout (core/distance/wide_bvh_layout.h), which a nearest-first
 // search walks 8 boxes and 8 triangle bounds at a time
 // (core/distance/wide_bvh_search.cpp). The search only culls: every
@@ -92,7 +92,9 @@ inline float RoundUpToFloat(double v) {
 wide::LeafBlock EmptyLeafBlock();
 // The query's share of the float leaf bound's error: 8 2^-24 |p|_1, rounded
 // up (core/distance/wide_bvh_search.cpp).
-float LeafMargin(const Eigen::Vector3d& p);
+inline float LeafMargin(const Eigen::Vector3d& p) {
+  return RoundUpToFloat(8 * 0x1p-24 * (std::abs(p.x()) + std::abs(p.y()) + std::abs(p.z())));
+}
 // The leaf bound of the given ISA (the tests compare them); SSE2 when this
 // machine lacks the ISA. At most 3 2^-24 above the exact squared prism
 // bound, which is at most the squared distance.

@@ -12,12 +12,19 @@
 
 namespace surfinspect::link_row {
 
+namespace {
+bool UseAvx2(RowIsa isa) {
+  return isa == RowIsa::kAvx2 || (isa == RowIsa::kAuto && RowIsaSupported(RowIsa::kAvx2));
+}
+}  // namespace
+
 // Copies w points into the SoA row (SSE2: 4 points = 3 loads, 7 shuffles).
-void Transpose(const Eigen::Vector3f* pts, uint32_t w, RowSoA& row) {
+void Transpose(const Eigen::Vector3f* pts, uint32_t w, RowSoA& row, RowIsa isa) {
   float* __restrict x = row.c(0);
   float* __restrict y = row.c(1);
   float* __restrict z = row.c(2);
   const float* f = pts[0].data();
+  if (UseAvx2(isa)) return avx2::Transpose(f, w, x, y, z);
   uint32_t i = 0;
 #if defined(__SSE2__)
   for (; i + 4 <= w; i += 4, f += 12) {
@@ -120,7 +127,7 @@ bool RowIsaSupported(RowIsa isa) {
 
 bool ComputeMasks(const RowSoA& cur, const RowSoA* up, bool diagonals, uint32_t words,
                   float link_distance_sq, const RowMasks& masks, RowIsa isa) {
-  if (isa == RowIsa::kAvx2 || (isa == RowIsa::kAuto && RowIsaSupported(RowIsa::kAvx2))) {
+  if (UseAvx2(isa)) {
     const float* const c[3] = {cur.c(0), cur.c(1), cur.c(2)};
     const float* const u[3] = {up ? up->c(0) : nullptr, up ? up->c(1) : nullptr,
                                up ? up->c(2) : nullptr};

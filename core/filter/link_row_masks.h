@@ -30,14 +30,15 @@ struct RowMasks {
   uint64_t *valid, *west, *north_west, *north, *north_east;
 };
 
-// Copies w points into the SoA row (SSE2: 4 points = 3 loads, 7 shuffles).
-void Transpose(const Eigen::Vector3f* pts, uint32_t w, RowSoA& row);
-
-// The row pass's instruction set. kAuto takes AVX2 (8 pixels per
+// The row kernels' instruction set. kAuto takes AVX2 (8 pixels per
 // instruction, link_row_masks_avx2.h) where the CPU has it, else SSE2; the
-// masks are the same bits in each.
+// rows and masks are the same bits in each.
 enum class RowIsa { kAuto, kSse2, kAvx2 };
 bool RowIsaSupported(RowIsa isa);
+
+// Copies w points into the SoA row (SSE2: 4 points = 3 loads, 7 shuffles).
+// `isa` must be supported.
+void Transpose(const Eigen::Vector3f* pts, uint32_t w, RowSoA& row, RowIsa isa = RowIsa::kAuto);
 
 // Fills `masks` for `words` 64-pixel words of `cur`: valid (all coordinates
 // finite), west link and, when `up` (the row above) is given, north and, with

@@ -62,4 +62,24 @@ bool RowBits(const float* const cur[3], const float* const up[3], bool diagonals
   return Pass<true, false>(cur, up, words, link_distance_sq, masks);
 }
 
+void Transpose(const float* f, uint32_t w, float* x, float* y, float* z) {
+  uint32_t i = 0;
+  for (; i + 8 <= w; i += 8, f += 24) {
+    // Lanes 0-3 hold points 0-3 and lanes 4-7 points 4-7, so each 128-bit
+    // half is the SSE2 transpose of four points.
+    const __m256 a = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(f)),
+                                          _mm_loadu_ps(f + 12), 1);  // x0 y0 z0 x1 | x4 y4 z4 x5
+    const __m256 b = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(f + 4)),
+                                          _mm_loadu_ps(f + 16), 1);  // y1 z1 x2 y2 | y5 z5 x6 y6
+    const __m256 c = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(f + 8)),
+                                          _mm_loadu_ps(f + 20), 1);  // z2 x3 y3 z3 | z6 x7 y7 z7
+    const __m256 xy = _mm256_shuffle_ps(b, c, _MM_SHUFFLE(2, 1, 3, 2));  // x2 y2 x3 y3
+    const __m256 yz = _mm256_shuffle_ps(a, b, _MM_SHUFFLE(1, 0, 2, 1));  // y0 z0 y1 z1
+    _mm256_storeu_ps(x + i, _mm256_shuffle_ps(a, xy, _MM_SHUFFLE(2, 0, 3, 0)));
+    _mm256_storeu_ps(y + i, _mm256_shuffle_ps(yz, xy, _MM_SHUFFLE(3, 1, 2, 0)));
+    _mm256_storeu_ps(z + i, _mm256_shuffle_ps(yz, c, _MM_SHUFFLE(3, 0, 3, 1)));
+  }
+  for (; i < w; ++i, f += 3) x[i] = f[0], y[i] = f[1], z[i] = f[2];
+}
+
 }  // namespace surfinspect::link_row::avx2

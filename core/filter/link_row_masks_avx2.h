@@ -1,4 +1,4 @@
-// The AVX2 build of link_row_masks.cpp's row pass (link_row_masks_avx2.cpp,
+// The AVX2 build of link_row_masks.cpp's transpose and row pass (link_row_masks_avx2.cpp,
 // compiled with -mavx2): 8 pixels per instruction, the same float
 // operations in the same order, so every mask bit is the SSE2 pass's. Plain
 // types only, so that no inline function of another header is compiled
@@ -15,5 +15,9 @@ namespace surfinspect::link_row::avx2 {
 // whether an infinite coordinate was seen. Call only where AVX2 runs.
 bool RowBits(const float* const cur[3], const float* const up[3], bool diagonals, uint32_t words,
              float link_distance_sq, uint64_t* const masks[5]);
+
+// w points (x, y, z interleaved in `points`) into the planes x, y, z: 8
+// points per 3 loads, 5 shuffles and 3 stores. Call only where AVX2 runs.
+void Transpose(const float* points, uint32_t w, float* x, float* y, float* z);
 
 }  // namespace surfinspect::link_row::avx2

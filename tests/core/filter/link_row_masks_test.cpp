@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <random>
 
 #include "core/filter/link_clustering.h"
@@ -106,6 +107,27 @@ TEST_P(LinkRowMasks, FirstRowHasNoVerticalLinksAndInfinityIsReported) {
   pts[69] = {0.f, -INFINITY, NAN};
   Transpose(pts.data(), 70, row);
   EXPECT_TRUE(ComputeMasks(row, nullptr, true, 2, 0.25f, m, GetParam()));
+}
+
+// Each set's transpose gives the points' coordinates plane by plane, NaN
+// and infinity included, for widths on and off its vector width.
+TEST_P(LinkRowMasks, TransposeCopiesEveryCoordinate) {
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<float> u(-100.f, 100.f);
+  for (uint32_t w : {1u, 7u, 8u, 9u, 64u, 70u, 1024u}) {
+    std::vector<Eigen::Vector3f> pts(w);
+    for (auto& p : pts) p = {u(rng), u(rng), u(rng)};
+    pts[0].y() = NAN;
+    pts[w - 1].z() = -INFINITY;
+    RowSoA row(64 * ((w + 63) / 64));
+    Transpose(pts.data(), w, row, GetParam());
+    for (uint32_t i = 0; i < w; ++i)
+      for (int a = 0; a < 3; ++a) {
+        const float want = pts[i][a], got = row.c(a)[i];
+        ASSERT_EQ(std::memcmp(&want, &got, sizeof want), 0) << "w " << w << " point " << i;
+      }
+    EXPECT_TRUE(std::isnan(row.c(0)[-1]));  // the padding is left alone
+  }
 }
 
 // Starts and ends against their per-pixel definitions, across words, and
