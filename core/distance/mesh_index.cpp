@@ -63,6 +63,9 @@ bool Consider(wide::Query& q, QueryState& s, uint32_t t, const PointTriangleResu
 // block's copy of its vertices (the mesh's floats, exactly).
 bool OfferLane(wide::Query& q, const wide::LeafBlock& block, int lane) {
   auto& s = *static_cast<QueryState*>(q.context);
+  // The best so far (usually the hint) again: the kernel would give the
+  // same distance, which is no improvement.
+  if (block.triangle[lane] == s.best_triangle) return false;
   Eigen::Vector3d v[3];
   for (int k = 0; k < 3; ++k)
     v[k] = Eigen::Vector3d(block.vertex[k][0][lane], block.vertex[k][1][lane],

@@ -134,6 +134,9 @@ class WideBvhBuilder {
       if (leaf.item.count == 0 || leaf.item.count > 255)
         return absl::InternalError(
             absl::StrCat("wide BVH: a leaf of ", leaf.item.count, " triangles"));
+      // A leaf is read with one block's bound, at the cost of some empty lanes.
+      if (slots_ % wide::kLeafWidth + leaf.item.count > wide::kLeafWidth)
+        slots_ += wide::kLeafWidth - slots_ % wide::kLeafWidth;
       out_.nodes_[parent].child[slot] = slots_;
       out_.nodes_[parent].leaf_triangles[slot] = static_cast<uint8_t>(leaf.item.count);
       AddLeaf(leaf, box);
@@ -153,8 +156,8 @@ class WideBvhBuilder {
     return absl::OkStatus();
   }
 
-  // Triangles go to consecutive lanes: a leaf may start inside a block and
-  // end in the next, so no lane is left empty between leaves.
+  // Triangles go to consecutive lanes (AddChild has moved a leaf that
+  // would not fit in what is left of the current block to the next one).
   void AddLeaf(const BuildLeaf& leaf, Box& box) {
     for (uint32_t i = 0; i < leaf.item.count; ++i) {
       if (slots_ % wide::kLeafWidth == 0) out_.blocks_.push_back(EmptyLeafBlock());

@@ -156,10 +156,16 @@ SURFINSPECT_INLINE void VisitLeaf(const View& view, uint32_t first, uint32_t cou
     const F8 bound2 = Bounds2(block, p, q.leaf_margin);
     uint32_t mask = LessEqualMask(bound2, q.box_radius2) & lanes;
     while (mask != 0) {
-      const int lane = __builtin_ctz(mask);
-      mask &= mask - 1;
-      // An earlier lane may have lowered the best distance since.
-      if (bound2[lane] <= q.box_radius2) q.offer(q, block, lane);
+      // The smallest bound first: it is the likeliest to be the answer, and
+      // the radius it leaves culls the other lanes before their kernel.
+      int lane = __builtin_ctz(mask);
+      for (uint32_t rest = mask & (mask - 1); rest != 0; rest &= rest - 1) {
+        const int other = __builtin_ctz(rest);
+        if (bound2[other] < bound2[lane]) lane = other;
+      }
+      mask &= ~(1u << lane);
+      q.offer(q, block, lane);
+      mask &= LessEqualMask(bound2, q.box_radius2);
     }
   }
 }
