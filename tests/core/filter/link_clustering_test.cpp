@@ -228,27 +228,6 @@ TEST(LinkClusteringGrid, WideGridsCrossMaskWords) {
   }
 }
 
-TEST(LinkClusteringGrid, SnakesAndSpiralsNeedManyMerges) {
-  // Long serpentine components meet the row-by-row labelling at many
-  // places; links exist only along the snake (other heights jump 5 mm).
-  for (int conn : {4, 8}) {
-    const uint32_t w = 37, h = 41;
-    PointCloud c = PointCloud::Organized(w, h);
-    for (uint32_t r = 0; r < h; ++r)
-      for (uint32_t col = 0; col < w; ++col) {
-        // Comb: every other column is a tooth joined at the bottom or top.
-        const bool on = (col % 2 == 0) || (r == (col % 4 == 1 ? h - 1 : 0));
-        c.points[r * w + col] = {0.3f * col, 0.3f * r, on ? 0.f : 5.f + 7.f * ((r + col) % 2)};
-      }
-    LinkClusteringSettings s = HalfMm();
-    s.connectivity = conn;
-    auto r = ClusterLinks(c, s);
-    ASSERT_TRUE(r.ok());
-    ExpectSamePartition(r->labels, GridOracle(c, conn, LinkDistanceSquared(0.5)));
-    EXPECT_EQ(r->largest_cluster, (w / 2 + 1) * h + w / 2);
-  }
-}
-
 // Ids count up in raster order of each component's first point.
 void ExpectRasterNumbering(const std::vector<int32_t>& labels) {
   int32_t next = 0;
@@ -258,6 +237,29 @@ void ExpectRasterNumbering(const std::vector<int32_t>& labels) {
     ++next;
   }
 }
+
+// A comb: every other column is a tooth, joined to the next at the bottom
+// or the top; links exist only along it (other heights jump 5 mm). One
+// component, met by the row-by-row labelling at many places.
+void ExpectTheCombIsOneComponent(uint32_t w, uint32_t h) {
+  for (int conn : {4, 8}) {
+    PointCloud c = PointCloud::Organized(w, h);
+    for (uint32_t r = 0; r < h; ++r)
+      for (uint32_t col = 0; col < w; ++col) {
+        const bool on = (col % 2 == 0) || (r == (col % 4 == 1 ? h - 1 : 0));
+        c.points[r * w + col] = {0.3f * col, 0.3f * r, on ? 0.f : 5.f + 7.f * ((r + col) % 2)};
+      }
+    LinkClusteringSettings s = HalfMm();
+    s.connectivity = conn;
+    auto r = ClusterLinks(c, s);
+    ASSERT_TRUE(r.ok());
+    ExpectSamePartition(r->labels, GridOracle(c, conn, LinkDistanceSquared(0.5)));
+    ExpectRasterNumbering(r->labels);
+    EXPECT_EQ(r->largest_cluster, (w / 2 + 1) * h + w / 2) << w << "x" << h << " conn " << conn;
+  }
+}
+
+TEST(LinkClusteringGrid, SnakesAndSpiralsNeedManyMerges) { ExpectTheCombIsOneComponent(37, 41); }
 
 TEST(LinkClusteringGrid, TallGridsJoinTheirBandsAtTheSeams) {
   // Rows are labelled in bands of 64 and the bands joined: components that
@@ -282,24 +284,8 @@ TEST(LinkClusteringGrid, TallGridsJoinTheirBandsAtTheSeams) {
       if (HasFatalFailure()) return;
     }
   }
-  // A comb whose teeth run through four bands and join only at the top or
-  // the bottom: one component, built almost wholly from seam merges.
-  for (int conn : {4, 8}) {
-    const uint32_t w = 21, h = 250;
-    PointCloud c = PointCloud::Organized(w, h);
-    for (uint32_t r = 0; r < h; ++r)
-      for (uint32_t col = 0; col < w; ++col) {
-        const bool on = (col % 2 == 0) || (r == (col % 4 == 1 ? h - 1 : 0));
-        c.points[r * w + col] = {0.3f * col, 0.3f * r, on ? 0.f : 5.f + 7.f * ((r + col) % 2)};
-      }
-    LinkClusteringSettings s = HalfMm();
-    s.connectivity = conn;
-    auto r = ClusterLinks(c, s);
-    ASSERT_TRUE(r.ok());
-    ExpectSamePartition(r->labels, GridOracle(c, conn, LinkDistanceSquared(0.5)));
-    ExpectRasterNumbering(r->labels);
-    EXPECT_EQ(r->largest_cluster, (w / 2 + 1) * h + w / 2);
-  }
+  // A comb whose teeth run through four bands: almost every merge is a seam's.
+  ExpectTheCombIsOneComponent(21, 250);
 }
 
 TEST(LinkClusteringGrid, SingleRowAndSingleColumn) {
