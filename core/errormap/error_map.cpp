@@ -29,13 +29,15 @@ bool FillUnlessCancelled(std::vector<T>& v, std::size_t n, const T& value,
   return true;
 }
 
-ComponentStats Summarize(const std::vector<double>& values) {
+// In double, in the vector's order, whatever its element type.
+template <typename T>
+ComponentStats Summarize(const std::vector<T>& values) {
   ComponentStats c;
   if (values.empty()) return c;
   double sum = 0, sum2 = 0;
   c.min_mm = INFINITY;
   c.max_mm = -INFINITY;
-  for (double v : values) {
+  for (const double v : values) {
     sum += v;
     sum2 += v * v;
     c.min_mm = std::min(c.min_mm, v);
@@ -68,25 +70,21 @@ bool ComputeStats(const ErrorMapSettings& settings, ErrorMapResult& r,
   }
   if (!matched.empty()) {
     // Two passes in double, in input order: deterministic to the last bit.
-    const std::vector<double> as_double(matched.begin(), matched.end());
-    const ComponentStats s = Summarize(as_double);
+    const ComponentStats s = Summarize(matched);
     double var = 0;
-    for (double d : as_double) var += (d - s.mean_mm) * (d - s.mean_mm);
+    for (const double d : matched) var += (d - s.mean_mm) * (d - s.mean_mm);
     r.stats.min_mm = s.min_mm;
     r.stats.max_mm = s.max_mm;
     r.stats.mean_mm = s.mean_mm;
     r.stats.rms_mm = s.rms_mm;
-    r.stats.stddev_mm = std::sqrt(var / as_double.size());
-    Percentiles<float> p(matched);  // increasing q, as it requires
-    const std::pair<double, double*> percentiles[] = {{0.01, &r.stats.p1_mm},
-                                                      {0.05, &r.stats.p5_mm},
-                                                      {0.50, &r.stats.p50_mm},
-                                                      {0.95, &r.stats.p95_mm},
-                                                      {0.99, &r.stats.p99_mm}};
-    for (const auto& [q, out] : percentiles) {
-      if (IsCancelled(cancel)) return false;
-      *out = p.At(q);
-    }
+    r.stats.stddev_mm = std::sqrt(var / matched.size());
+    if (IsCancelled(cancel)) return false;
+    const std::vector<double> p = FloatPercentiles(matched, {0.01, 0.05, 0.50, 0.95, 0.99});
+    r.stats.p1_mm = p[0];
+    r.stats.p5_mm = p[1];
+    r.stats.p50_mm = p[2];
+    r.stats.p95_mm = p[3];
+    r.stats.p99_mm = p[4];
     v.fraction_within = static_cast<double>(v.within) / r.stats.matched;
     v.fraction_outside = 1.0 - v.fraction_within;
   }

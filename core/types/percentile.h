@@ -28,4 +28,16 @@ class Percentiles {
 extern template class Percentiles<float>;
 extern template class Percentiles<double>;
 
+// P(q) for each q of `qs` (at most 100, each in [0, 1); NaN otherwise or
+// for no values)
+// over floats, leaving `values` as they are: one pass counts the values by
+// the top 16 bits of an order-preserving key, a second gathers the few
+// buckets that hold the ranks the q need, and a selection within those
+// finishes. The results equal Percentiles<float>'s to the bit: the ranks
+// pick the same numbers, and the only floats that compare equal with other
+// bits, -0 and +0, come out of the interpolation as +0 either way (below
+// q = 1, where P(1) would be the largest value itself).
+std::vector<double> FloatPercentiles(const std::vector<float>& values,
+                                     const std::vector<double>& qs);
+
 }  // namespace surfinspect

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <vector>
 
@@ -53,6 +54,35 @@ TEST(Percentile, IncreasingQueriesMatchAFullSort) {
     const double want = sorted[lo] + (pos - lo) * (sorted[lo + 1] - sorted[lo]);
     EXPECT_DOUBLE_EQ(p.At(q), want) << q;
   }
+}
+
+// The counting form against the selection form, bit for bit: small and
+// large counts, heavy ties, negative values and both zeros.
+TEST(Percentile, FloatPercentilesEqualTheSelectionToTheBit) {
+  std::mt19937 rng(9);
+  std::normal_distribution<float> g(0.f, 0.3f);
+  const std::vector<double> qs = {0.0, 0.01, 0.05, 0.5, 0.95, 0.99, 0.999};
+  for (std::size_t n :
+       {std::size_t{1}, std::size_t{2}, std::size_t{3}, std::size_t{1000}, std::size_t{200000}}) {
+    for (int kind = 0; kind < 3; ++kind) {
+      std::vector<float> v(n);
+      for (float& x : v) {
+        x = g(rng);
+        if (kind == 1) x = std::round(x * 20) / 20;  // few distinct values
+        if (kind == 2 && rng() % 3 == 0) x = rng() % 2 ? 0.f : -0.f;
+      }
+      const std::vector<double> got = FloatPercentiles(v, qs);
+      std::vector<float> copy = v;
+      Percentiles<float> want(copy);
+      for (std::size_t i = 0; i < qs.size(); ++i) {
+        const double w = want.At(qs[i]);
+        ASSERT_EQ(std::memcmp(&got[i], &w, sizeof w), 0)
+            << "n " << n << " kind " << kind << " q " << qs[i] << ": " << got[i] << " vs " << w;
+      }
+    }
+  }
+  EXPECT_TRUE(std::isnan(FloatPercentiles({}, {0.5})[0]));
+  EXPECT_TRUE(std::isnan(FloatPercentiles({1.f, 2.f}, {1.0})[0]));
 }
 
 }  // namespace
