@@ -45,9 +45,9 @@ constexpr std::size_t kCancelStride = std::size_t{1} << 16;
 // Visiting order for an unorganized cloud: 30-bit Morton codes on a 1024^3
 // grid over the bounds, sorted by a stable radix sort (equal codes keep
 // input order). Invalid points go last. The codes are computed in parallel
-// blocks (each depends only on its point), and so is the sort. Empty if
-// cancelled.
-std::vector<uint32_t> MortonOrder(const PointCloud& cloud, const std::atomic<bool>* cancel) {
+// blocks (each depends only on its point). The result holds code << 32 |
+// point index, in visiting order; empty if cancelled.
+std::vector<uint64_t> MortonOrder(const PointCloud& cloud, const std::atomic<bool>* cancel) {
   const Bounds3 bounds = ComputeBounds(cloud);
   const std::size_t n = cloud.size();
   const double extent = bounds.empty() ? 0.0 : (bounds.max - bounds.min).maxCoeff();
@@ -74,13 +74,7 @@ std::vector<uint32_t> MortonOrder(const PointCloud& cloud, const std::atomic<boo
         }
       });
   if (stopped.load() || !RadixSortPacked(items, 31, cancel)) return {};
-  std::vector<uint32_t> order(n);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kCancelStride),
-                    [&](const tbb::blocked_range<std::size_t>& block) {
-                      for (std::size_t i = block.begin(); i != block.end(); ++i)
-                        order[i] = static_cast<uint32_t>(items[i]);
-                    });
-  return order;
+  return items;
 }
 
 absl::Status CheckInputs(const PointCloud& points, const Eigen::Isometry3d& mesh_from_points,
@@ -111,7 +105,7 @@ absl::Status QueryClosestEach(const MeshIndex& index, const PointCloud& points,
   const auto t0 = std::chrono::steady_clock::now();
   tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
   // A grid is already coherent row by row; anything else gets Morton order.
-  std::vector<uint32_t> order;
+  std::vector<uint64_t> order;  // code << 32 | point index
   if (settings.coherent_start && !points.organized() && n <= UINT32_MAX) {
     arena.execute([&] { order = MortonOrder(points, cancel); });
     if (order.empty()) return absl::CancelledError("closest-point query cancelled");
@@ -127,7 +121,9 @@ absl::Status QueryClosestEach(const MeshIndex& index, const PointCloud& points,
   // on 10^6 points).
   auto run_chunk = [&](std::size_t chunk) {
     const std::size_t begin = chunk * kChunk, count = std::min(n - begin, kChunk);
-    auto index_of = [&](std::size_t k) { return order.empty() ? begin + k : order[begin + k]; };
+    auto index_of = [&](std::size_t k) -> std::size_t {
+      return order.empty() ? begin + k : static_cast<uint32_t>(order[begin + k]);
+    };
     std::array<Eigen::Vector3d, kChunk> p;  // mesh frame
     std::array<bool, kChunk> valid;
     for (std::size_t k = 0; k < count; ++k) {
