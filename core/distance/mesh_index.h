@@ -104,7 +104,7 @@ class MeshIndex {
  private:
   MeshIndex() = default;
   void ComputeFaceNormals();
-  void ComputeFeatureNormals();
+  void ComputeFeatureNormals();  // mesh_index_normals.cpp
   const Eigen::Vector3d& Pseudonormal(uint32_t triangle, ClosestFeature feature) const;
 
   TriangleMesh mesh_;

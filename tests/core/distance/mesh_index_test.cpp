@@ -1,5 +1,6 @@
-// Covers core/distance/mesh_index.cpp (MeshIndex::Closest against brute force, signs against
-// winding numbers) and core/distance/mesh_index_batch.cpp (QueryClosest and QueryClosestEach:
+// Covers core/distance/mesh_index.cpp (MeshIndex::Closest against brute force),
+// core/distance/mesh_index_normals.cpp (signs against winding numbers) and
+// core/distance/mesh_index_batch.cpp (QueryClosest and QueryClosestEach:
 // one and many threads, coherent start, Morton order, cancel, bad input).
 #include "core/distance/mesh_index.h"
 
