@@ -131,7 +131,8 @@ class WideBvhBuilder {
     Box box;
     if (item->leaf) {
       const auto& leaf = *reinterpret_cast<const BuildLeaf*>(item);
-      if (leaf.item.count == 0 || leaf.item.count > 255)
+      // The search reads a leaf from one block.
+      if (leaf.item.count == 0 || leaf.item.count > wide::kMaxLeafTriangles)
         return absl::InternalError(
             absl::StrCat("wide BVH: a leaf of ", leaf.item.count, " triangles"));
       // A leaf is read with one block's bound, at the cost of some empty lanes.

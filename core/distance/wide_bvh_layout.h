@@ -34,7 +34,7 @@ struct alignas(32) Node {
 };
 
 // Eight consecutive leaf lanes (lane k of block b is lane 8b + k of the
-// leaves; a leaf is a run of lanes and may span two blocks), each a
+// leaves; a leaf is a run of lanes inside one block), each a
 // triangle with what the leaf's lower bound needs, stored as
 // floats: the vertices exactly, the unit face normal n and the in-plane
 // outward edge normals m_k rounded, which the slack covers

@@ -143,30 +143,25 @@ SURFINSPECT_INLINE F8 Bounds2(const LeafBlock& block, const F8 p[3], float margi
   return below * below + out * out;
 }
 
-// The leaf of lanes [first, first + count), one block at a time.
+// The leaf of lanes [first, first + count), which lie in one block (the
+// builder never lets a leaf cross a block boundary).
 SURFINSPECT_INLINE void VisitLeaf(const View& view, uint32_t first, uint32_t count, const F8 p[3],
                                   Query& q) {
-  const uint32_t end = first + count;
-  for (uint32_t b = first / kLeafWidth; b * kLeafWidth < end; ++b) {
-    const LeafBlock& block = view.blocks[b];
-    const uint32_t base = b * kLeafWidth;
-    const uint32_t from = first > base ? first - base : 0;
-    const uint32_t to = end - base < kLeafWidth ? end - base : kLeafWidth;
-    const uint32_t lanes = ((1u << to) - 1) & ~((1u << from) - 1);
-    const F8 bound2 = Bounds2(block, p, q.leaf_margin);
-    uint32_t mask = LessEqualMask(bound2, q.box_radius2) & lanes;
-    while (mask != 0) {
-      // The smallest bound first: it is the likeliest to be the answer, and
-      // the radius it leaves culls the other lanes before their kernel.
-      int lane = __builtin_ctz(mask);
-      for (uint32_t rest = mask & (mask - 1); rest != 0; rest &= rest - 1) {
-        const int other = __builtin_ctz(rest);
-        if (bound2[other] < bound2[lane]) lane = other;
-      }
-      mask &= ~(1u << lane);
-      q.offer(q, block, lane);
-      mask &= LessEqualMask(bound2, q.box_radius2);
+  const LeafBlock& block = view.blocks[first / kLeafWidth];
+  const uint32_t lanes = ((1u << count) - 1) << (first % kLeafWidth);
+  const F8 bound2 = Bounds2(block, p, q.leaf_margin);
+  uint32_t mask = LessEqualMask(bound2, q.box_radius2) & lanes;
+  while (mask != 0) {
+    // The smallest bound first: it is the likeliest to be the answer, and
+    // the radius it leaves culls the other lanes before their kernel.
+    int lane = __builtin_ctz(mask);
+    for (uint32_t rest = mask & (mask - 1); rest != 0; rest &= rest - 1) {
+      const int other = __builtin_ctz(rest);
+      if (bound2[other] < bound2[lane]) lane = other;
     }
+    mask &= ~(1u << lane);
+    q.offer(q, block, lane);
+    mask &= LessEqualMask(bound2, q.box_radius2);
   }
 }
 
@@ -176,21 +171,46 @@ struct Entry {
   uint32_t leaf_triangles;  // 0 for a node
 };
 
-// The node's children within the radius, nearest first.
-SURFINSPECT_INLINE int LiveChildren(const Node& node, const F8 p[3], float radius2,
-                                    Entry live[kWidth]) {
-  const F8 d2 = BoxDistance2(node, p);
-  uint32_t mask = LessEqualMask(d2, radius2) & ((1u << node.count) - 1);
-  int n = 0;
-  while (mask != 0) {
-    const int i = __builtin_ctz(mask);
-    mask &= mask - 1;
-    const Entry e{d2[i], node.child[i], node.leaf_triangles[i]};
-    int j = n++;
-    for (; j > 0 && live[j - 1].d2 > e.d2; --j) live[j] = live[j - 1];
-    live[j] = e;
+SURFINSPECT_INLINE Entry ChildEntry(const Node& node, const float d2[kWidth], int i) {
+  return {d2[i], node.child[i], node.leaf_triangles[i]};
+}
+
+// Visits the node: its children within the radius go nearest first into
+// `next`, the others onto the stack, farthest deepest (equal distances in
+// slot order). Returns false when no child is within the radius. Most
+// nodes on a query's path have one or two such children, which skip the
+// sort.
+SURFINSPECT_INLINE bool Descend(const Node& node, const F8 p[3], float radius2, Entry& next,
+                                Entry* stack, int& top) {
+  const F8 d2v = BoxDistance2(node, p);
+  uint32_t mask = LessEqualMask(d2v, radius2) & ((1u << node.count) - 1);
+  if (mask == 0) return false;
+  float d2[kWidth];
+  std::memcpy(d2, &d2v, sizeof d2);
+  const int first = __builtin_ctz(mask);
+  const uint32_t rest = mask & (mask - 1);
+  if (rest == 0) {
+    next = ChildEntry(node, d2, first);
+    return true;
   }
-  return n;
+  if ((rest & (rest - 1)) == 0) {  // two: the nearer next, the lower slot on a tie
+    const int second = __builtin_ctz(rest);
+    const bool swap = d2[second] < d2[first];
+    next = ChildEntry(node, d2, swap ? second : first);
+    stack[top++] = ChildEntry(node, d2, swap ? first : second);
+    return true;
+  }
+  uint8_t order[kWidth];  // slots by distance, a stable insertion sort
+  int n = 0;
+  for (; mask != 0; mask &= mask - 1) {
+    const int i = __builtin_ctz(mask);
+    int j = n++;
+    for (; j > 0 && d2[order[j - 1]] > d2[i]; --j) order[j] = order[j - 1];
+    order[j] = static_cast<uint8_t>(i);
+  }
+  for (int j = n - 1; j >= 1; --j) stack[top++] = ChildEntry(node, d2, order[j]);
+  next = ChildEntry(node, d2, order[0]);
+  return true;
 }
 
 }  // namespace
@@ -204,15 +224,8 @@ void Search(const View& view, Query& q) {
     if (next.d2 <= q.box_radius2) {
       if (next.leaf_triangles != 0) {
         VisitLeaf(view, next.child, next.leaf_triangles, p, q);
-      } else {
-        Entry live[kWidth];
-        const int n = LiveChildren(view.nodes[next.child], p, q.box_radius2, live);
-        // The nearest child is visited next; the others wait, farthest deepest.
-        for (int j = n - 1; j >= 1; --j) stack[top++] = live[j];
-        if (n > 0) {
-          next = live[0];
-          continue;
-        }
+      } else if (Descend(view.nodes[next.child], p, q.box_radius2, next, stack, top)) {
+        continue;
       }
     }
     if (top == 0) return;
