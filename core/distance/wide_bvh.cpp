@@ -1,5 +1,8 @@
 #include "core/distance/wide_bvh.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -100,6 +103,26 @@ class WideBvhBuilder {
     return CopyNode(0, reinterpret_cast<const BuildNode*>(root), 1, nullptr);
   }
 
+  // The blocks' lanes, in parallel blocks (each lane depends only on its
+  // triangle), once the walk has placed every triangle.
+  void FillBlocks() {
+    const std::size_t blocks = (slots_ + wide::kLeafWidth - 1) / wide::kLeafWidth;
+    lane_triangle_.resize(blocks * wide::kLeafWidth, UINT32_MAX);
+    out_.blocks_.assign(blocks, EmptyLeafBlock());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, 256),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t b = r.begin(); b != r.end(); ++b)
+                          for (int lane = 0; lane < wide::kLeafWidth; ++lane) {
+                            const uint32_t t = lane_triangle_[b * wide::kLeafWidth + lane];
+                            if (t == UINT32_MAX) continue;
+                            const Triangle& tri = mesh_.triangles[t];
+                            const auto& v = mesh_.vertices;
+                            FillLeafLane(out_.blocks_[b], lane, t, v[tri[0]], v[tri[1]], v[tri[2]],
+                                         normals_[t], shapes_[t]);
+                          }
+                      });
+  }
+
  private:
   static wide::Node EmptyNode() {
     wide::Node node;
@@ -158,16 +181,15 @@ class WideBvhBuilder {
   }
 
   // Triangles go to consecutive lanes (AddChild has moved a leaf that
-  // would not fit in what is left of the current block to the next one).
+  // would not fit in what is left of the current block to the next one,
+  // leaving the lanes between unused); FillBlocks writes them.
   void AddLeaf(const BuildLeaf& leaf, Box& box) {
+    lane_triangle_.resize(slots_, UINT32_MAX);
     for (uint32_t i = 0; i < leaf.item.count; ++i) {
-      if (slots_ % wide::kLeafWidth == 0) out_.blocks_.push_back(EmptyLeafBlock());
       const uint32_t t = leaf.triangles[i];
-      const Triangle& tri = mesh_.triangles[t];
-      const auto& v = mesh_.vertices;
-      FillLeafLane(out_.blocks_.back(), static_cast<int>(slots_++ % wide::kLeafWidth), t, v[tri[0]],
-                   v[tri[1]], v[tri[2]], normals_[t], shapes_[t]);
-      for (int k = 0; k < 3; ++k) box.Extend(v[tri[k]]);
+      lane_triangle_.push_back(t);
+      ++slots_;
+      for (int k = 0; k < 3; ++k) box.Extend(mesh_.vertices[mesh_.triangles[t][k]]);
     }
   }
 
@@ -175,7 +197,8 @@ class WideBvhBuilder {
   const TriangleMesh& mesh_;
   const std::vector<Eigen::Vector3d>& normals_;
   const std::vector<TriangleShape>& shapes_;
-  uint32_t slots_ = 0;  // leaf lanes filled so far
+  uint32_t slots_ = 0;                   // leaf lanes placed so far
+  std::vector<uint32_t> lane_triangle_;  // per lane: its triangle, UINT32_MAX if unused
 };
 
 bool SearchIsaSupported(SearchIsa isa) {
@@ -244,6 +267,7 @@ absl::StatusOr<WideBvh> WideBvh::Build(RTCDevice device, const TriangleMesh& mes
   if (!root) return absl::InternalError("mesh index: Embree's BVH build failed");
   WideBvhBuilder builder(out, mesh, face_normals, shapes);
   if (auto st = builder.CopyRoot(root); !st.ok()) return st;
+  builder.FillBlocks();
   out.nodes_.shrink_to_fit();
   out.blocks_.shrink_to_fit();
   out.stats_.nodes = out.nodes_.size();
