@@ -92,6 +92,38 @@ absl::Status CheckInputs(const PointCloud& points, const Eigen::Isometry3d& mesh
   return absl::OkStatus();
 }
 
+// The searches of one chunk, in visiting order: each query starts at
+// radius previous distance + |p - p_prev| with the previous point's triangle
+// as its hint (when settings.coherent_start).
+void SearchChunk(const MeshIndex& index, const BatchQuerySettings& settings,
+                 const Eigen::Vector3d* p, const bool* valid, std::size_t count,
+                 ClosestPoint* results) {
+  const double max_d = settings.max_distance_mm;
+  Eigen::Vector3d prev_p = Eigen::Vector3d::Zero();
+  double prev_d = NAN;  // no anchor yet
+  uint32_t prev_triangle = UINT32_MAX;
+  for (std::size_t k = 0; k < count; ++k) {
+    ClosestPoint& r = results[k];
+    if (!valid[k]) {
+      r = ClosestPoint{};
+      continue;
+    }
+    double radius = max_d;
+    if (settings.coherent_start && std::isfinite(prev_d))
+      radius = std::min(radius, (prev_d + (p[k] - prev_p).norm()) * (1 + 1e-12) + 1e-12);
+    // The previous point's triangle, offered first, usually makes the
+    // radius nearly exact at once.
+    r = index.Closest(p[k], radius, settings.coherent_start ? prev_triangle : UINT32_MAX);
+    // The bound holds exactly; this only guards against its rounding.
+    if (!r.matched() && radius < max_d) r = index.Closest(p[k], max_d);
+    if (r.matched()) {
+      prev_p = p[k];
+      prev_d = r.distance_mm;
+      prev_triangle = r.triangle_id;
+    }
+  }
+}
+
 }  // namespace
 
 absl::Status QueryClosestEach(const MeshIndex& index, const PointCloud& points,
@@ -112,7 +144,6 @@ absl::Status QueryClosestEach(const MeshIndex& index, const PointCloud& points,
   }
   const auto t1 = std::chrono::steady_clock::now();
 
-  const double max_d = settings.max_distance_mm;
   std::atomic<bool> cancelled{false};
   // A chunk runs in three passes: gather its points, search them, hand the
   // results to the sink. In Morton order the input is read and the sink
@@ -132,29 +163,7 @@ absl::Status QueryClosestEach(const MeshIndex& index, const PointCloud& points,
       if (valid[k]) p[k] = mesh_from_points * q.cast<double>();
     }
     std::array<ClosestPoint, kChunk> results;
-    Eigen::Vector3d prev_p = Eigen::Vector3d::Zero();
-    double prev_d = NAN;  // no anchor yet
-    uint32_t prev_triangle = UINT32_MAX;
-    for (std::size_t k = 0; k < count; ++k) {
-      ClosestPoint& r = results[k];
-      if (!valid[k]) {
-        r = ClosestPoint{};
-        continue;
-      }
-      double radius = max_d;
-      if (settings.coherent_start && std::isfinite(prev_d))
-        radius = std::min(radius, (prev_d + (p[k] - prev_p).norm()) * (1 + 1e-12) + 1e-12);
-      // The previous point's triangle, offered first, usually makes the
-      // radius nearly exact at once.
-      r = index.Closest(p[k], radius, settings.coherent_start ? prev_triangle : UINT32_MAX);
-      // The bound holds exactly; this only guards against its rounding.
-      if (!r.matched() && radius < max_d) r = index.Closest(p[k], max_d);
-      if (r.matched()) {
-        prev_p = p[k];
-        prev_d = r.distance_mm;
-        prev_triangle = r.triangle_id;
-      }
-    }
+    SearchChunk(index, settings, p.data(), valid.data(), count, results.data());
     for (std::size_t k = 0; k < count; ++k) sink(index_of(k), results[k]);
   };
 

@@ -15,7 +15,7 @@
 // triangle whose bound exceeds the best distance so far would have lost to
 // it in the kernel as well (exact ties are kept). Slivers get a weaker
 // bound, never a wrong one. The leaves store n and m_k as floats and add
-// 2e-7 to the slack for that rounding (core/distance/wide_bvh.cpp).
+// 2e-7 to the slack for that rounding (core/distance/leaf_block.cpp).
 #pragma once
 
 #include <Eigen/Core>

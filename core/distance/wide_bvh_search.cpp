@@ -27,7 +27,7 @@
 // 1e-6 for that arithmetic, times |p - v|_1, capped at 2 (a slack of 1
 // already zeroes a term); the query's leaf margin, 8u |p|_1 rounded up,
 // covers rounding p and its effect on the slack's own product
-// (wide_bvh.cpp). So each term, and
+// (leaf_block.cpp). So each term, and
 // with it below and out, lands at or under its exact value, and the float
 // below^2 + out^2 at most 3u over the exact squared bound. Lanes are culled
 // only against the padded box radius above, at least (1 + 2e-6) times the

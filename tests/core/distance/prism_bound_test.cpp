@@ -1,3 +1,5 @@
+// Covers core/distance/prism_bound.cpp (the double bound) and
+// core/distance/leaf_block.cpp (the lanes the float leaf bound reads, in each ISA).
 #include "core/distance/prism_bound.h"
 
 #include <gtest/gtest.h>
