@@ -118,31 +118,4 @@ PointTriangleResult ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen
   return Make(p, a + ab * (vb * denom) + ac * (vc * denom), F::kFace);
 }
 
-int FeatureIndex(ClosestFeature f) {
-  switch (f) {
-    case ClosestFeature::kEdgeAB:
-    case ClosestFeature::kVertexA:
-      return 0;
-    case ClosestFeature::kEdgeBC:
-    case ClosestFeature::kVertexB:
-      return 1;
-    case ClosestFeature::kEdgeCA:
-    case ClosestFeature::kVertexC:
-      return 2;
-    case ClosestFeature::kFace:
-      break;
-  }
-  return -1;
-}
-
-bool IsEdge(ClosestFeature f) {
-  return f == ClosestFeature::kEdgeAB || f == ClosestFeature::kEdgeBC ||
-         f == ClosestFeature::kEdgeCA;
-}
-
-bool IsVertex(ClosestFeature f) {
-  return f == ClosestFeature::kVertexA || f == ClosestFeature::kVertexB ||
-         f == ClosestFeature::kVertexC;
-}
-
 }  // namespace surfinspect

@@ -49,10 +49,21 @@ PointTriangleResult ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen
                                            const Eigen::Vector3d& b, const Eigen::Vector3d& c,
                                            TriangleShape shape);
 
+// Inline: every query's sign asks them.
+inline bool IsEdge(ClosestFeature f) {
+  return f == ClosestFeature::kEdgeAB || f == ClosestFeature::kEdgeBC ||
+         f == ClosestFeature::kEdgeCA;
+}
+inline bool IsVertex(ClosestFeature f) {
+  return f == ClosestFeature::kVertexA || f == ClosestFeature::kVertexB ||
+         f == ClosestFeature::kVertexC;
+}
 // Index 0..2 of the edge's first vertex (AB -> 0, BC -> 1, CA -> 2) or of the
 // vertex (A -> 0, ...); -1 for kFace.
-int FeatureIndex(ClosestFeature f);
-bool IsEdge(ClosestFeature f);
-bool IsVertex(ClosestFeature f);
+inline int FeatureIndex(ClosestFeature f) {
+  if (IsEdge(f)) return static_cast<int>(f) - static_cast<int>(ClosestFeature::kEdgeAB);
+  if (IsVertex(f)) return static_cast<int>(f) - static_cast<int>(ClosestFeature::kVertexA);
+  return -1;
+}
 
 }  // namespace surfinspect

@@ -164,7 +164,8 @@ absl::StatusOr<ErrorMapResult> ComputeErrorMap(const MeshIndex& index,
   if (auto st = ValidateErrorMapSettings(settings); !st.ok()) return st;
   const absl::Status cancelled = absl::CancelledError("error map cancelled");
   if (IsCancelled(cancel)) return cancelled;
-  if (auto st = cloud_in_world.Validate(); !st.ok()) return st;
+  // The cloud itself is checked by the query below (PointCloud::Validate),
+  // which a second pass over every point here would repeat.
   if (!world_from_part.matrix().allFinite())
     return absl::InvalidArgumentError("error map: world_from_part is not finite");
   const std::size_t n = cloud_in_world.size();

@@ -128,13 +128,20 @@ TEST(PointTriangle, DegenerateTrianglesFallBackToSegments) {
 }
 
 TEST(PointTriangle, FeatureHelpers) {
-  EXPECT_EQ(FeatureIndex(F::kFace), -1);
-  EXPECT_EQ(FeatureIndex(F::kEdgeBC), 1);
-  EXPECT_EQ(FeatureIndex(F::kVertexC), 2);
-  EXPECT_TRUE(IsEdge(F::kEdgeCA));
-  EXPECT_FALSE(IsEdge(F::kVertexA));
-  EXPECT_TRUE(IsVertex(F::kVertexB));
-  EXPECT_FALSE(IsVertex(F::kFace));
+  // Every feature: its index (an edge's first vertex, or the vertex) and kind.
+  const struct {
+    F f;
+    int index;
+    bool edge, vertex;
+  } want[] = {{F::kFace, -1, false, false},  {F::kEdgeAB, 0, true, false},
+              {F::kEdgeBC, 1, true, false},  {F::kEdgeCA, 2, true, false},
+              {F::kVertexA, 0, false, true}, {F::kVertexB, 1, false, true},
+              {F::kVertexC, 2, false, true}};
+  for (const auto& w : want) {
+    EXPECT_EQ(FeatureIndex(w.f), w.index) << static_cast<int>(w.f);
+    EXPECT_EQ(IsEdge(w.f), w.edge) << static_cast<int>(w.f);
+    EXPECT_EQ(IsVertex(w.f), w.vertex) << static_cast<int>(w.f);
+  }
 }
 
 }  // namespace

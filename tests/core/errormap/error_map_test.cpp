@@ -271,6 +271,17 @@ TEST(ErrorMap, RejectsBadSettingsAndHonoursCancel) {
   Eigen::Isometry3d bad_pose = Eigen::Isometry3d::Identity();
   bad_pose(0, 3) = INFINITY;
   EXPECT_EQ(ComputeErrorMap(*index, cloud, bad_pose, {}).status().code(), kBad);
+  // A malformed cloud: an infinite coordinate, a grid of the wrong size.
+  PointCloud infinite = cloud;
+  infinite.points[1234].y() = -INFINITY;
+  const auto st = ComputeErrorMap(*index, infinite, Eigen::Isometry3d::Identity(), {}).status();
+  EXPECT_EQ(st.code(), kBad);
+  EXPECT_NE(st.message().find("point 1234 has an infinite coordinate"), std::string::npos) << st;
+  PointCloud wrong = cloud;
+  wrong.width = 7;
+  wrong.height = 3;
+  EXPECT_EQ(ComputeErrorMap(*index, wrong, Eigen::Isometry3d::Identity(), {}).status().code(),
+            kBad);
   std::atomic<bool> cancel{true};
   EXPECT_EQ(
       ComputeErrorMap(*index, cloud, Eigen::Isometry3d::Identity(), {}, &cancel).status().code(),
