@@ -155,12 +155,15 @@ absl::Status QueryClosestEach(const MeshIndex& index, const PointCloud& points,
     auto index_of = [&](std::size_t k) -> std::size_t {
       return order.empty() ? begin + k : static_cast<uint32_t>(order[begin + k]);
     };
+    // The copy is its own loop, with nothing that waits on the loaded
+    // values, so many of its cache misses are in flight at once.
+    std::array<Eigen::Vector3f, kChunk> raw;
+    for (std::size_t k = 0; k < count; ++k) raw[k] = points.points[index_of(k)];
     std::array<Eigen::Vector3d, kChunk> p;  // mesh frame
     std::array<bool, kChunk> valid;
     for (std::size_t k = 0; k < count; ++k) {
-      const Eigen::Vector3f& q = points.points[index_of(k)];
-      valid[k] = PointCloud::IsValid(q);
-      if (valid[k]) p[k] = mesh_from_points * q.cast<double>();
+      valid[k] = PointCloud::IsValid(raw[k]);
+      if (valid[k]) p[k] = mesh_from_points * raw[k].cast<double>();
     }
     std::array<ClosestPoint, kChunk> results;
     SearchChunk(index, settings, p.data(), valid.data(), count, results.data());
