@@ -10,6 +10,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/io/atomic_file.h"
+#include "core/types/round_half_away.h"
 
 namespace surfinspect {
 namespace {
@@ -56,7 +57,7 @@ class BufferedFile {
 
 Rgb Lerp(Rgb a, Rgb b, double t) {
   auto mix = [t](uint8_t x, uint8_t y) {
-    return static_cast<uint8_t>(std::lround(x + (static_cast<double>(y) - x) * t));
+    return static_cast<uint8_t>(RoundHalfAwayFromZero(x + (static_cast<double>(y) - x) * t));
   };
   return {mix(a.r, b.r), mix(a.g, b.g), mix(a.b, b.b)};
 }
