@@ -96,17 +96,29 @@ inline void AddServiceRows(std::vector<Row>& rows) {
   req.set_return_deviations(true);
 
   ErrorMapResult local;
-  const double t_local = MedianSeconds(7, true, [&] {
-    auto r = ComputeErrorMap(**index, cloud, cell.world_from_part, {});
-    if (r.ok()) local = std::move(*r);
-  });
   v1::ErrorMapResponse remote;
   bool remote_ok = true;
-  const double t_remote = MedianSeconds(7, true, [&] {  // warm-up caches the mesh by hash
-    auto r = (*client)->ErrorMap(req, cell.part);
-    remote_ok = remote_ok && r.ok();
-    if (r.ok()) remote = std::move(*r);
-  });
+  // A client builds its request once and moves it into the call, so each
+  // call gets its own copy made here, untimed. The two sides alternate, so
+  // a change in the machine's load hits both alike.
+  constexpr int kReps = 7;
+  std::vector<v1::ErrorMapRequest> requests(kReps + 1, req);  // + the warm-up
+  std::size_t next = 0;
+  const auto [t_local, t_remote] = MedianSecondsInterleaved(
+      kReps, true,
+      [&] {
+        auto r = ComputeErrorMap(**index, cloud, cell.world_from_part, {});
+        if (r.ok()) local = std::move(*r);
+      },
+      [&] {  // the warm-up caches the mesh
+        if (next == requests.size()) {
+          remote_ok = false;
+          return;
+        }
+        auto r = (*client)->ErrorMap(std::move(requests[next++]), cell.part);
+        remote_ok = remote_ok && r.ok();
+        if (r.ok()) remote = std::move(*r);
+      });
   // Agreement: the deviations sent back equal the in-process ones.
   std::size_t differ = 0;
   const std::string& bytes = remote.deviations();

@@ -6,6 +6,8 @@
 #include <random>
 #include <vector>
 
+#include "absl/strings/str_cat.h"
+
 namespace surfinspect {
 namespace {
 
@@ -99,6 +101,27 @@ TEST(PointCloud, ValidateChecksTheGridAndRejectsInfinities) {
     EXPECT_NE(st.message().find("point 7"), std::string::npos) << st;
     EXPECT_NE(st.message().find("infinite"), std::string::npos) << st;
   }
+}
+
+// The check reads the floats as one array: an infinity anywhere, on any
+// axis and of either sign, among NaNs and finite points, is found and named
+// by its point; a cloud of NaNs, huge and tiny finite values passes.
+TEST(PointCloud, ValidateFindsEveryInfinityAndNamesTheFirst) {
+  PointCloud c = PointCloud::Unorganized(std::vector<Vector3f>(37, Vector3f(1, -2, 3)));
+  c.points[3] = Vector3f(NAN, NAN, NAN);
+  c.points[4] = Vector3f(3.4e38f, -3.4e38f, 1e-45f);
+  c.points[5] = Vector3f(NAN, 0, -0.f);
+  ASSERT_TRUE(c.Validate().ok());
+  for (std::size_t i = 0; i < c.size(); ++i)
+    for (int axis = 0; axis < 3; ++axis)
+      for (float inf : {INFINITY, -INFINITY}) {
+        PointCloud bad = c;
+        bad.points[i][axis] = inf;
+        if (i + 7 < c.size()) bad.points[i + 7][2] = INFINITY;  // a later one is not named
+        const absl::Status st = bad.Validate();
+        ASSERT_EQ(st.code(), absl::StatusCode::kInvalidArgument) << i << " " << axis;
+        EXPECT_NE(st.message().find(absl::StrCat("point ", i, " has")), std::string::npos) << st;
+      }
 }
 
 TEST(PointCloud, ValidatePointsLooksOnlyAtItsRange) {
