@@ -11,25 +11,11 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/distance/embree_handles.h"
+#include "core/distance/hint_certificate.h"
 #include "core/distance/wide_bvh.h"
 
 namespace surfinspect {
 namespace {
-
-// The search culls boxes in float, with the query point rounded to float
-// (relative error 2^-24 per coordinate; the bound is derived in
-// core/distance/wide_bvh_search.cpp). Padding the radius well beyond that
-// keeps the true minimiser and every exact tie inside the search, so the
-// double-precision answer is the brute-force answer.
-float SearchRadius(double distance_mm, double coordinate_scale) {
-  if (!(distance_mm < static_cast<double>(std::numeric_limits<float>::max()) / 2)) return INFINITY;
-  const double padded = distance_mm * (1 + 1e-6) + 1e-6 * coordinate_scale + 1e-9;
-  return NextUp(static_cast<float>(padded));
-}
-
-// The radius squared, rounded up to a float (the double product is exact:
-// 48 bits).
-float SearchRadius2(float radius) { return RoundUpToFloat(static_cast<double>(radius) * radius); }
 
 struct QueryState {
   Eigen::Vector3d p;
@@ -41,10 +27,17 @@ struct QueryState {
   PointTriangleResult best;
 };
 
+// The float search radius for the best squared distance so far.
+float BoxRadius2(const wide::Query& q, const QueryState& s) {
+  return SearchRadius2(SearchRadius(std::sqrt(q.best_d2), s.coordinate_scale));
+}
+
 // Keeps the lexicographic minimum of (squared distance, triangle id), so the
-// answer does not depend on the order triangles are offered in, and shrinks
-// the search radius after an improvement.
-bool Consider(wide::Query& q, QueryState& s, uint32_t t, const PointTriangleResult& r) {
+// answer does not depend on the order triangles are offered in. Inside a
+// search the radius shrinks after each improvement; outside one
+// (`in_search` false) it is set once, before the search starts.
+bool Consider(wide::Query& q, QueryState& s, uint32_t t, const PointTriangleResult& r,
+              bool in_search) {
   const bool better = s.best_triangle == UINT32_MAX
                           ? r.squared_distance <= q.best_d2
                           : r.squared_distance < q.best_d2 ||
@@ -53,7 +46,7 @@ bool Consider(wide::Query& q, QueryState& s, uint32_t t, const PointTriangleResu
   s.best = r;
   s.best_triangle = t;
   q.best_d2 = r.squared_distance;
-  q.box_radius2 = SearchRadius2(SearchRadius(std::sqrt(r.squared_distance), s.coordinate_scale));
+  if (in_search) q.box_radius2 = BoxRadius2(q, s);
   return true;
 }
 
@@ -70,18 +63,25 @@ bool OfferLane(wide::Query& q, const wide::LeafBlock& block, int lane) {
                            block.vertex[k][2][lane]);
   return Consider(
       q, s, block.triangle[lane],
-      ClosestPointOnTriangle(s.p, v[0], v[1], v[2], static_cast<TriangleShape>(block.shape[lane])));
+      ClosestPointOnTriangle(s.p, v[0], v[1], v[2], static_cast<TriangleShape>(block.shape[lane])),
+      true);
 }
 
-// The hint, from the mesh.
-void OfferTriangle(wide::Query& q, uint32_t t) {
+// The hint, or a triangle next to the best so far, from the mesh; true
+// when it is the new best.
+bool OfferTriangle(wide::Query& q, uint32_t t) {
   auto& s = *static_cast<QueryState*>(q.context);
   const Triangle& tri = s.triangles[t];
-  Consider(q, s, t,
-           ClosestPointOnTriangle(s.p, s.vertices[tri[0]].cast<double>(),
-                                  s.vertices[tri[1]].cast<double>(),
-                                  s.vertices[tri[2]].cast<double>(), s.shapes[t]));
+  return Consider(q, s, t,
+                  ClosestPointOnTriangle(s.p, s.vertices[tri[0]].cast<double>(),
+                                         s.vertices[tri[1]].cast<double>(),
+                                         s.vertices[tri[2]].cast<double>(), s.shapes[t]),
+                  false);
 }
+
+// Steps across the edges the best closest point lies on, at most this many
+// times: the scan points' hints are mostly one triangle off.
+constexpr int kMaxSteps = 2;
 
 RTCBuildQuality ToEmbree(BvhQuality q) {
   switch (q) {
@@ -139,6 +139,26 @@ absl::StatusOr<std::unique_ptr<MeshIndex>> MeshIndex::Build(TriangleMesh mesh,
     return bvh.status();
   }
   index->bvh_ = std::make_unique<WideBvh>(*std::move(bvh));
+  if (settings.hint_certificates) {
+    const auto certificate_start = std::chrono::steady_clock::now();
+    bool out_of_memory = false;
+    arena.execute([&] {
+      try {
+        index->certificates_ = std::make_unique<HintCertificates>(
+            HintCertificates::Build(index->mesh_, index->weld_, index->face_normal_, *index->bvh_));
+      } catch (const std::bad_alloc&) {
+        out_of_memory = true;
+      }
+    });
+    if (out_of_memory)
+      return absl::ResourceExhaustedError(
+          absl::StrCat("mesh index: out of memory building the hint certificates of ",
+                       index->mesh_.num_triangles(), " triangles"));
+    index->info_.certifiable_triangles = index->certificates_->certifiable();
+    index->info_.hint_alone_triangles = index->certificates_->alone();
+    index->info_.certificate_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - certificate_start).count();
+  }
   index->info_.triangles = index->mesh_.num_triangles();
   index->info_.bvh_nodes = index->bvh_->stats().nodes;
   index->info_.bvh_depth = index->bvh_->stats().depth;
@@ -178,8 +198,9 @@ const Eigen::Vector3d& MeshIndex::Pseudonormal(uint32_t triangle, ClosestFeature
 }
 
 ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_distance_mm,
-                                uint32_t hint_triangle) const {
+                                uint32_t hint_triangle, QueryPath* path) const {
   ClosestPoint out;
+  if (path) *path = QueryPath::kTree;
   if (!p_in_mesh.allFinite() || !(max_distance_mm >= 0)) return out;
   QueryState s{p_in_mesh,
                mesh_.vertices.data(),
@@ -201,7 +222,12 @@ ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_dis
   // A good first candidate (the previous point's triangle) starts the
   // search with a nearly exact radius; the result is the same without it.
   if (hint_triangle < mesh_.num_triangles()) OfferTriangle(q, hint_triangle);
-  bvh_->Search(q);
+  const QueryPath taken = CertifiedByHint(q, hint_triangle);
+  if (taken == QueryPath::kTree) {
+    if (s.best_triangle != UINT32_MAX) q.box_radius2 = BoxRadius2(q, s);
+    bvh_->Search(q);
+  }
+  if (path) *path = taken;
   if (s.best_triangle == UINT32_MAX) return out;
 
   const uint32_t t = s.best_triangle;
@@ -219,13 +245,51 @@ ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_dis
   return out;
 }
 
+// When the hint's certificate proves that the answer is the hint
+// (kHintAlone) or lies in the hint's ring (kRing, after offering the ring's
+// lanes), `q` holds the answer the whole tree would give
+// (core/distance/hint_certificate.h); kTree otherwise.
+QueryPath MeshIndex::CertifiedByHint(wide::Query& q, uint32_t hint_triangle) const {
+  const auto& s = *static_cast<const QueryState*>(q.context);
+  if (!certificates_ || s.best_triangle != hint_triangle || hint_triangle == UINT32_MAX)
+    return QueryPath::kTree;
+  for (int step = 0; step < kMaxSteps && s.best.feature != ClosestFeature::kFace; ++step) {
+    // Across the closest edge, or across both edges at the closest corner.
+    const HintCertificate& at = certificates_->of(s.best_triangle);
+    const int k = FeatureIndex(s.best.feature);
+    if (k < 0) break;
+    const uint32_t first = at.across[k];
+    const uint32_t second = IsVertex(s.best.feature) ? at.across[(k + 2) % 3] : UINT32_MAX;
+    bool moved = false;
+    if (first != UINT32_MAX) moved |= OfferTriangle(q, first);
+    if (second != UINT32_MAX) moved |= OfferTriangle(q, second);
+    if (!moved) break;
+  }
+  const uint32_t t = s.best_triangle;
+  const HintCertificate& c = certificates_->of(t);
+  const double d = std::sqrt(q.best_d2);
+  if (!c.Certifies(s.p, d, s.coordinate_scale)) return QueryPath::kTree;
+  if (s.best.feature == ClosestFeature::kFace) {
+    const Triangle& tri = mesh_.triangles[t];
+    const Eigen::Vector3d a[3] = {mesh_.vertices[tri[0]].cast<double>(),
+                                  mesh_.vertices[tri[1]].cast<double>(),
+                                  mesh_.vertices[tri[2]].cast<double>()};
+    if (RingIsFarther(c.rise, s.p, s.best.point, d, face_normal_[t], a))
+      return QueryPath::kHintAlone;
+  }
+  q.box_radius2 = BoxRadius2(q, s);
+  for (int j = 0; j < c.blocks; ++j) bvh_->VisitLanes(c.block[j], c.lanes[j], q);
+  return QueryPath::kRing;
+}
+
 std::size_t MeshIndex::memory_bytes() const {
   return sizeof(*this) + mesh_.vertices.capacity() * sizeof(Eigen::Vector3f) +
          mesh_.triangles.capacity() * sizeof(Triangle) +
          face_normal_.capacity() * sizeof(Eigen::Vector3d) + shape_.capacity() +
          triangle_edges_.capacity() * sizeof(triangle_edges_[0]) +
          edge_normal_.capacity() * sizeof(Eigen::Vector3d) + weld_.capacity() * sizeof(uint32_t) +
-         vertex_normal_.capacity() * sizeof(Eigen::Vector3d) + (bvh_ ? bvh_->memory_bytes() : 0);
+         vertex_normal_.capacity() * sizeof(Eigen::Vector3d) + (bvh_ ? bvh_->memory_bytes() : 0) +
+         (certificates_ ? certificates_->memory_bytes() : 0);
 }
 
 }  // namespace surfinspect

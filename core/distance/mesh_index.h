@@ -41,6 +41,7 @@
 namespace surfinspect {
 
 class WideBvh;
+class HintCertificates;
 
 struct ClosestPoint {
   uint32_t triangle_id = UINT32_MAX;  // UINT32_MAX = unmatched
@@ -56,6 +57,11 @@ struct ClosestPoint {
 
 enum class BvhQuality { kLow, kMedium, kHigh };
 
+// How a query found its answer: by the tree, by the hint's certificate
+// and its ring's lanes, or by the hint's certificate alone
+// (core/distance/hint_certificate.h). The answer is the same in each.
+enum class QueryPath : uint8_t { kTree, kRing, kHintAlone };
+
 struct MeshIndexSettings {
   // Embree's build: kLow sorts by Morton codes (fast to build), kMedium and
   // kHigh split by the surface area heuristic (slower to build, faster to
@@ -63,6 +69,11 @@ struct MeshIndexSettings {
   BvhQuality build_quality = BvhQuality::kHigh;
   int build_threads = 0;                    // Embree build threads; 0 = all cores
   SearchIsa search_isa = SearchIsa::kAuto;  // the answers are the same in each
+  // Per-triangle certificates that let a query whose hint is close enough
+  // skip the tree (core/distance/hint_certificate.h). The answers are the
+  // same either way; building them costs about one search per triangle, so
+  // they pay when there are several queries per triangle.
+  bool hint_certificates = true;
 };
 
 // What Build() found in the mesh; reported with the error map.
@@ -75,6 +86,10 @@ struct MeshIndexInfo {
   std::size_t bvh_nodes = 0;
   int bvh_depth = 0;
   const char* search_isa = "";  // "sse2" or "avx2"
+  // Triangles whose hint certificate can certify (0 when they are off).
+  std::size_t certifiable_triangles = 0;
+  std::size_t hint_alone_triangles = 0;  // of them, those that can also prove themselves alone
+  double certificate_seconds = 0;        // their share of build_seconds
   double build_seconds = 0;
 };
 
@@ -92,12 +107,16 @@ class MeshIndex {
   // within `max_distance_mm` (inclusive), otherwise unmatched. A non-finite
   // point is unmatched. `hint_triangle`, a triangle likely to be close (the
   // previous scan point's), only speeds the search up: the answer is the
-  // same with any hint or none. Thread-safe.
+  // same with any hint or none. `path`, when given, is set to how the
+  // answer was found. Thread-safe.
   ClosestPoint Closest(const Eigen::Vector3d& p_in_mesh, double max_distance_mm = INFINITY,
-                       uint32_t hint_triangle = UINT32_MAX) const;
+                       uint32_t hint_triangle = UINT32_MAX, QueryPath* path = nullptr) const;
 
   const TriangleMesh& mesh() const { return mesh_; }
   const MeshIndexInfo& info() const { return info_; }
+  // The BVH and the hint certificates (null when off), for their tests.
+  const WideBvh& bvh() const { return *bvh_; }
+  const HintCertificates* hint_certificates() const { return certificates_.get(); }
   // Mesh, pseudonormals and the BVH, for an LRU cache of indices.
   std::size_t memory_bytes() const;
 
@@ -106,6 +125,7 @@ class MeshIndex {
   void ComputeFaceNormals();
   void ComputeFeatureNormals();  // mesh_index_normals.cpp
   const Eigen::Vector3d& Pseudonormal(uint32_t triangle, ClosestFeature feature) const;
+  QueryPath CertifiedByHint(wide::Query& q, uint32_t hint_triangle) const;
 
   TriangleMesh mesh_;
   MeshIndexInfo info_;
@@ -116,6 +136,7 @@ class MeshIndex {
   std::vector<uint32_t> weld_;                           // vertex -> representative vertex
   std::vector<Eigen::Vector3d> vertex_normal_;           // per representative: angle-weighted sum
   std::unique_ptr<WideBvh> bvh_;
+  std::unique_ptr<HintCertificates> certificates_;  // null when off
 };
 
 constexpr int kMaxQueryThreads = 1024;  // the largest task arena a batch query makes
@@ -150,6 +171,10 @@ absl::StatusOr<std::vector<ClosestPoint>> QueryClosest(const MeshIndex& index,
 struct BatchQueryTiming {
   double order_seconds = 0;
   double search_seconds = 0;
+  // Answered without the tree by the hint's certificate: with its ring's
+  // lanes, and (of those) by the hint alone.
+  std::size_t certified_points = 0;
+  std::size_t hint_alone_points = 0;
 };
 
 absl::Status QueryClosestEach(const MeshIndex& index, const PointCloud& points,

@@ -217,7 +217,9 @@ absl::StatusOr<WideBvh> WideBvh::Build(RTCDevice device, const TriangleMesh& mes
         absl::StrCat("mesh index: this CPU cannot run the ", SearchIsaName(isa), " search"));
   WideBvh out;
   out.isa_ = ResolveSearchIsa(isa);
-  out.search_ = out.isa_ == SearchIsa::kAvx2 ? &wide::avx2::Search : &wide::sse2::Search;
+  const bool avx2 = out.isa_ == SearchIsa::kAvx2;
+  out.search_ = avx2 ? &wide::avx2::Search : &wide::sse2::Search;
+  out.visit_ = avx2 ? &wide::avx2::VisitLanes : &wide::sse2::VisitLanes;
   const std::size_t n = mesh.triangles.size();
   if (n == 0) {
     out.nodes_.push_back(wide::Node{});

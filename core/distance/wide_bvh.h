@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstring>
+#include <limits>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -51,6 +52,12 @@ class WideBvh {
                                        RTCBuildQuality quality, SearchIsa isa);
 
   void Search(wide::Query& query) const { search_(view(), query); }
+  // Offers the lanes set in `lanes` of one block, culled by the leaf bound
+  // as the search culls a leaf (core/distance/hint_certificate.h).
+  void VisitLanes(uint32_t block, uint32_t lanes, wide::Query& query) const {
+    visit_(view(), block, lanes, query);
+  }
+  const std::vector<wide::LeafBlock>& blocks() const { return blocks_; }
   wide::View view() const { return {nodes_.data(), blocks_.data()}; }
   SearchIsa isa() const { return isa_; }
   const WideBvhStats& stats() const { return stats_; }
@@ -61,6 +68,7 @@ class WideBvh {
   std::vector<wide::LeafBlock> blocks_;
   SearchIsa isa_ = SearchIsa::kSse2;
   void (*search_)(const wide::View&, wide::Query&) = &wide::sse2::Search;
+  void (*visit_)(const wide::View&, uint32_t, uint32_t, wide::Query&) = &wide::sse2::VisitLanes;
   WideBvhStats stats_;
   friend class WideBvhBuilder;
 };
@@ -87,6 +95,22 @@ inline float NextUp(float f) {
 inline float RoundUpToFloat(double v) {
   const float f = static_cast<float>(v);
   return static_cast<double>(f) >= v ? f : NextUp(f);
+}
+// The search culls boxes in float, with the query point rounded to float
+// (relative error 2^-24 per coordinate; the bound is derived in
+// core/distance/wide_bvh_search.cpp). Padding the radius well beyond that
+// keeps the true minimiser and every exact tie inside the search, so the
+// double-precision answer is the brute-force answer. `coordinate_scale` is
+// the query point's largest |coordinate|.
+inline float SearchRadius(double distance_mm, double coordinate_scale) {
+  if (!(distance_mm < static_cast<double>(std::numeric_limits<float>::max()) / 2)) return INFINITY;
+  const double padded = distance_mm * (1 + 1e-6) + 1e-6 * coordinate_scale + 1e-9;
+  return NextUp(static_cast<float>(padded));
+}
+// The radius squared, rounded up to a float (the double product is exact:
+// 48 bits).
+inline float SearchRadius2(float radius) {
+  return RoundUpToFloat(static_cast<double>(radius) * radius);
 }
 // A block with every lane unused.
 wide::LeafBlock EmptyLeafBlock();

@@ -66,14 +66,17 @@ struct Query {
   bool (*offer)(Query& query, const LeafBlock& block, int lane);
 };
 
-// The search and the leaf bound, one namespace per instruction set. Results
-// are the same in each (the tests compare them).
+// The search, a visit of chosen lanes of one block (bounds, then the
+// offers, as the search visits a leaf) and the leaf bound, one namespace per
+// instruction set. Results are the same in each (the tests compare them).
 namespace sse2 {
 void Search(const View& view, Query& query);
+void VisitLanes(const View& view, uint32_t block, uint32_t lanes, Query& query);
 void BlockBounds2(const LeafBlock& block, const float p[3], float margin, float out[kLeafWidth]);
 }  // namespace sse2
 namespace avx2 {
 void Search(const View& view, Query& query);
+void VisitLanes(const View& view, uint32_t block, uint32_t lanes, Query& query);
 void BlockBounds2(const LeafBlock& block, const float p[3], float margin, float out[kLeafWidth]);
 }  // namespace avx2
 

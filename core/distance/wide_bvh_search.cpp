@@ -143,12 +143,10 @@ SURFINSPECT_INLINE F8 Bounds2(const LeafBlock& block, const F8 p[3], float margi
   return below * below + out * out;
 }
 
-// The leaf of lanes [first, first + count), which lie in one block (the
-// builder never lets a leaf cross a block boundary).
-SURFINSPECT_INLINE void VisitLeaf(const View& view, uint32_t first, uint32_t count, const F8 p[3],
-                                  Query& q) {
-  const LeafBlock& block = view.blocks[first / kLeafWidth];
-  const uint32_t lanes = ((1u << count) - 1) << (first % kLeafWidth);
+// The lanes of one block set in `lanes`, each offered unless its bound
+// exceeds the radius.
+SURFINSPECT_INLINE void VisitBlock(const LeafBlock& block, uint32_t lanes, const F8 p[3],
+                                   Query& q) {
   const F8 bound2 = Bounds2(block, p, q.leaf_margin);
   uint32_t mask = LessEqualMask(bound2, q.box_radius2) & lanes;
   while (mask != 0) {
@@ -163,6 +161,13 @@ SURFINSPECT_INLINE void VisitLeaf(const View& view, uint32_t first, uint32_t cou
     q.offer(q, block, lane);
     mask &= LessEqualMask(bound2, q.box_radius2);
   }
+}
+
+// The leaf of lanes [first, first + count), which lie in one block (the
+// builder never lets a leaf cross a block boundary).
+SURFINSPECT_INLINE void VisitLeaf(const View& view, uint32_t first, uint32_t count, const F8 p[3],
+                                  Query& q) {
+  VisitBlock(view.blocks[first / kLeafWidth], ((1u << count) - 1) << (first % kLeafWidth), p, q);
 }
 
 struct Entry {
@@ -231,6 +236,11 @@ void Search(const View& view, Query& q) {
     if (top == 0) return;
     next = stack[--top];
   }
+}
+
+void VisitLanes(const View& view, uint32_t block, uint32_t lanes, Query& q) {
+  const F8 p[3] = {F8{} + q.pf[0], F8{} + q.pf[1], F8{} + q.pf[2]};
+  VisitBlock(view.blocks[block], lanes, p, q);
 }
 
 void BlockBounds2(const LeafBlock& block, const float p[3], float margin, float out[kLeafWidth]) {

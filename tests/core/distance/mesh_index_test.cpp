@@ -89,18 +89,20 @@ std::vector<Vector3d> OracleQueryPoints(const TriangleMesh& m, uint64_t seed) {
   return pts;
 }
 
-// Every search this machine runs, with both kinds of build: the answers
-// must be the same in each.
+// Every search this machine runs, with both kinds of build and with the
+// hint certificates on and off: the answers must be the same in each.
 std::vector<MeshIndexSettings> AllSearches() {
   std::vector<MeshIndexSettings> all;
   for (SearchIsa isa : {SearchIsa::kSse2, SearchIsa::kAvx2})
-    for (BvhQuality quality : {BvhQuality::kLow, BvhQuality::kHigh}) {
-      if (!SearchIsaSupported(isa)) continue;
-      MeshIndexSettings s;
-      s.search_isa = isa;
-      s.build_quality = quality;
-      all.push_back(s);
-    }
+    for (BvhQuality quality : {BvhQuality::kLow, BvhQuality::kHigh})
+      for (bool certificates : {true, false}) {
+        if (!SearchIsaSupported(isa)) continue;
+        MeshIndexSettings s;
+        s.search_isa = isa;
+        s.build_quality = quality;
+        s.hint_certificates = certificates;
+        all.push_back(s);
+      }
   return all;
 }
 
