@@ -32,6 +32,15 @@ float BoxRadius2(const wide::Query& q, const QueryState& s) {
   return SearchRadius2(SearchRadius(std::sqrt(q.best_d2), s.coordinate_scale));
 }
 
+// The float radius and leaf margin a search culls with: from the best so
+// far, or from the distance limit before any triangle is within it.
+void PrepareSearch(wide::Query& q, const QueryState& s, double max_distance_mm) {
+  q.box_radius2 = s.best_triangle != UINT32_MAX
+                      ? BoxRadius2(q, s)
+                      : SearchRadius2(SearchRadius(max_distance_mm, s.coordinate_scale));
+  q.leaf_margin = LeafMargin(s.p);
+}
+
 // Keeps the lexicographic minimum of (squared distance, triangle id), so the
 // answer does not depend on the order triangles are offered in. Inside a
 // search the radius shrinks after each improvement; outside one
@@ -213,8 +222,8 @@ ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_dis
                 {static_cast<float>(p_in_mesh.x()), static_cast<float>(p_in_mesh.y()),
                  static_cast<float>(p_in_mesh.z())},
                 max_distance_mm * max_distance_mm,
-                SearchRadius2(SearchRadius(max_distance_mm, s.coordinate_scale)),
-                LeafMargin(p_in_mesh),
+                0,  // the radius and the margin are set before a search needs them
+                0,
                 &s,
                 &OfferLane};
   // Beyond float range the boxes cannot place the point; such a point is unmatched.
@@ -224,7 +233,7 @@ ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_dis
   if (hint_triangle < mesh_.num_triangles()) OfferTriangle(q, hint_triangle);
   const QueryPath taken = CertifiedByHint(q, hint_triangle);
   if (taken == QueryPath::kTree) {
-    if (s.best_triangle != UINT32_MAX) q.box_radius2 = BoxRadius2(q, s);
+    PrepareSearch(q, s, max_distance_mm);
     bvh_->Search(q);
   }
   if (path) *path = taken;
@@ -277,7 +286,7 @@ QueryPath MeshIndex::CertifiedByHint(wide::Query& q, uint32_t hint_triangle) con
     if (RingIsFarther(c.rise, s.p, s.best.point, d, face_normal_[t], a))
       return QueryPath::kHintAlone;
   }
-  q.box_radius2 = BoxRadius2(q, s);
+  PrepareSearch(q, s, INFINITY);
   for (int j = 0; j < c.blocks; ++j) bvh_->VisitLanes(c.block[j], c.lanes[j], q);
   return QueryPath::kRing;
 }

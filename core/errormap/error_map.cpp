@@ -211,6 +211,8 @@ absl::StatusOr<ErrorMapResult> ComputeErrorMap(const MeshIndex& index,
   const auto queried = std::chrono::steady_clock::now();
   r.query_seconds = std::chrono::duration<double>(queried - start).count();
   r.order_seconds = timing.order_seconds;
+  r.certified_points = timing.certified_points;
+  r.hint_alone_points = timing.hint_alone_points;
 
   if (IsCancelled(cancel)) return cancelled;
   r.stats.count = n;

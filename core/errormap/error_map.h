@@ -103,6 +103,10 @@ struct ErrorMapResult {
   double query_seconds = 0;
   double order_seconds = 0;
   double statistics_seconds = 0;
+  // Queries the hint certificates answered without the tree, and of them
+  // by the hint alone (core/distance/hint_certificate.h).
+  std::size_t certified_points = 0;
+  std::size_t hint_alone_points = 0;
 };
 
 // `cloud_in_world` is mapped into the part frame with world_from_part^-1.

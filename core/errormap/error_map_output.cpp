@@ -237,7 +237,9 @@ nlohmann::json ErrorMapReportJson(const ErrorMapResult& r, const ErrorMapSetting
                        {"normal", Stats(r.component_stats[3])}};
   j["timing"] = {{"query_seconds", r.query_seconds},
                  {"order_seconds", r.order_seconds},
-                 {"statistics_seconds", r.statistics_seconds}};
+                 {"statistics_seconds", r.statistics_seconds},
+                 {"certified_points", r.certified_points},
+                 {"hint_alone_points", r.hint_alone_points}};
   return j;
 }
 

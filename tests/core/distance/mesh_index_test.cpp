@@ -726,5 +726,12 @@ TEST(MeshIndexBatch, QueryClosestEachCallsTheSinkOnceForEveryIndex) {
   EXPECT_LT(sunk.load(), static_cast<int>(cloud.size()));
 }
 
+TEST(MeshIndex, OneShotCallsBuildHintCertificatesOnlyWithEnoughPointsPerTriangle) {
+  EXPECT_FALSE(CertificatesPayOnce(1'000'000, 180'000));  // the whole-command bench
+  EXPECT_TRUE(CertificatesPayOnce(786'432, 20'000));      // a 1024x768 view on a small part
+  EXPECT_TRUE(CertificatesPayOnce(16, 1));
+  EXPECT_FALSE(CertificatesPayOnce(15, 1));
+}
+
 }  // namespace
 }  // namespace surfinspect
