@@ -92,18 +92,6 @@ bool OfferTriangle(wide::Query& q, uint32_t t) {
 // times: the scan points' hints are mostly one triangle off.
 constexpr int kMaxSteps = 2;
 
-RTCBuildQuality ToEmbree(BvhQuality q) {
-  switch (q) {
-    case BvhQuality::kLow:
-      return RTC_BUILD_QUALITY_LOW;
-    case BvhQuality::kMedium:
-      return RTC_BUILD_QUALITY_MEDIUM;
-    case BvhQuality::kHigh:
-      break;
-  }
-  return RTC_BUILD_QUALITY_HIGH;
-}
-
 }  // namespace
 
 MeshIndex::~MeshIndex() = default;
@@ -134,7 +122,7 @@ absl::StatusOr<std::unique_ptr<MeshIndex>> MeshIndex::Build(TriangleMesh mesh,
       tbb::parallel_invoke(
           [&] {
             bvh = WideBvh::Build((*device)->get(), index->mesh_, index->face_normal_, index->shape_,
-                                 ToEmbree(settings.build_quality), settings.search_isa);
+                                 EmbreeBuildQuality(settings.build_quality), settings.search_isa);
           },
           [&] { index->ComputeFeatureNormals(); });
     } catch (const std::bad_alloc&) {

@@ -55,8 +55,6 @@ struct ClosestPoint {
   bool matched() const { return triangle_id != UINT32_MAX; }
 };
 
-enum class BvhQuality { kLow, kMedium, kHigh };
-
 // How a query found its answer: by the tree, by the hint's certificate
 // and its ring's lanes, or by the hint's certificate alone
 // (core/distance/hint_certificate.h). The answer is the same in each.

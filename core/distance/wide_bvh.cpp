@@ -204,6 +204,18 @@ SearchIsa ResolveSearchIsa(SearchIsa isa) {
   return SearchIsaSupported(SearchIsa::kAvx2) ? SearchIsa::kAvx2 : SearchIsa::kSse2;
 }
 
+RTCBuildQuality EmbreeBuildQuality(BvhQuality quality) {
+  switch (quality) {
+    case BvhQuality::kLow:
+      return RTC_BUILD_QUALITY_LOW;
+    case BvhQuality::kMedium:
+      return RTC_BUILD_QUALITY_MEDIUM;
+    case BvhQuality::kHigh:
+      break;
+  }
+  return RTC_BUILD_QUALITY_HIGH;
+}
+
 const char* SearchIsaName(SearchIsa isa) {
   return ResolveSearchIsa(isa) == SearchIsa::kAvx2 ? "avx2" : "sse2";
 }

@@ -28,6 +28,7 @@
 
 namespace surfinspect {
 
+RTCBuildQuality EmbreeBuildQuality(BvhQuality quality);
 // "sse2" or "avx2"; kAuto resolves first.
 const char* SearchIsaName(SearchIsa isa);
 // kAuto as it resolves on this machine.

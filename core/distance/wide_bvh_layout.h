@@ -12,6 +12,8 @@ namespace surfinspect {
 // Which compiled search a mesh index uses; kAuto picks the widest this CPU
 // runs (core/distance/wide_bvh.h).
 enum class SearchIsa { kAuto, kSse2, kAvx2 };
+// Embree's build quality for a mesh index (MeshIndexSettings::build_quality).
+enum class BvhQuality { kLow, kMedium, kHigh };
 
 }  // namespace surfinspect
 
