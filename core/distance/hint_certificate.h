@@ -52,6 +52,12 @@ struct HintCertificate {
   // looks next.
   uint32_t across[3] = {UINT32_MAX, UINT32_MAX, UINT32_MAX};
 
+  // True when p is within `reaches` times the reach of the anchor: a cheap
+  // test of whether a step or two across the mesh could end in a proof.
+  bool Near(const Eigen::Vector3d& p, double reaches) const {
+    const Eigen::Vector3d to_anchor(p.x() - anchor[0], p.y() - anchor[1], p.z() - anchor[2]);
+    return to_anchor.squaredNorm() < reaches * reaches * reach_mm * reach_mm;
+  }
   // True when the certificate proves that no triangle outside the ring is
   // as close to `p` as `hint_distance_mm`, with a margin above the
   // kernel's rounding at coordinates up to `coordinate_scale` (mm).

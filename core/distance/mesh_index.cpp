@@ -195,7 +195,8 @@ const Eigen::Vector3d& MeshIndex::Pseudonormal(uint32_t triangle, ClosestFeature
 }
 
 ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_distance_mm,
-                                uint32_t hint_triangle, QueryPath* path) const {
+                                uint32_t hint_triangle, QueryPath* path,
+                                bool try_certificate) const {
   ClosestPoint out;
   if (path) *path = QueryPath::kTree;
   if (!p_in_mesh.allFinite() || !(max_distance_mm >= 0)) return out;
@@ -219,7 +220,7 @@ ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_dis
   // A good first candidate (the previous point's triangle) starts the
   // search with a nearly exact radius; the result is the same without it.
   if (hint_triangle < mesh_.num_triangles()) OfferTriangle(q, hint_triangle);
-  const QueryPath taken = CertifiedByHint(q, hint_triangle);
+  const QueryPath taken = try_certificate ? CertifiedByHint(q, hint_triangle) : QueryPath::kTree;
   if (taken == QueryPath::kTree) {
     PrepareSearch(q, s, max_distance_mm);
     bvh_->Search(q);
@@ -250,6 +251,9 @@ QueryPath MeshIndex::CertifiedByHint(wide::Query& q, uint32_t hint_triangle) con
   const auto& s = *static_cast<const QueryState*>(q.context);
   if (!certificates_ || s.best_triangle != hint_triangle || hint_triangle == UINT32_MAX)
     return QueryPath::kTree;
+  // Two steps move the anchor by about a triangle: a point farther than
+  // twice the hint's reach from its anchor would not certify after them.
+  if (!certificates_->of(hint_triangle).Near(s.p, 2)) return QueryPath::kTree;
   for (int step = 0; step < kMaxSteps && s.best.feature != ClosestFeature::kFace; ++step) {
     // Across the closest edge, or across both edges at the closest corner.
     const HintCertificate& at = certificates_->of(s.best_triangle);

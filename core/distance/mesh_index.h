@@ -117,9 +117,11 @@ class MeshIndex {
   // point is unmatched. `hint_triangle`, a triangle likely to be close (the
   // previous scan point's), only speeds the search up: the answer is the
   // same with any hint or none. `path`, when given, is set to how the
-  // answer was found. Thread-safe.
+  // answer was found; `try_certificate` false skips the hint's certificate
+  // (the answer is the same). Thread-safe.
   ClosestPoint Closest(const Eigen::Vector3d& p_in_mesh, double max_distance_mm = INFINITY,
-                       uint32_t hint_triangle = UINT32_MAX, QueryPath* path = nullptr) const;
+                       uint32_t hint_triangle = UINT32_MAX, QueryPath* path = nullptr,
+                       bool try_certificate = true) const;
 
   const TriangleMesh& mesh() const { return mesh_; }
   const MeshIndexInfo& info() const { return info_; }

@@ -27,6 +27,11 @@ namespace surfinspect {
 namespace {
 
 constexpr std::size_t kChunk = 256;  // points per chunk: the unit of work and of cancel polling
+// A certificate that fails costs a query a few kernel calls: where they
+// keep failing (a mesh fine compared with the points' spacing, triangles
+// large compared with their reach), a chunk whose first this many tries
+// certified fewer than a quarter stops trying. The answers are the same.
+constexpr std::size_t kCertificateProbe = 16;
 
 // Spreads the low 10 bits of v to every third bit (Morton interleave).
 uint64_t Spread10(uint64_t v) {
@@ -103,6 +108,8 @@ void SearchChunk(const MeshIndex& index, const BatchQuerySettings& settings,
   Eigen::Vector3d prev_p = Eigen::Vector3d::Zero();
   double prev_d = NAN;  // no anchor yet
   uint32_t prev_triangle = UINT32_MAX;
+  std::size_t tried = 0, certified = 0;
+  bool certify = true;
   for (std::size_t k = 0; k < count; ++k) {
     ClosestPoint& r = results[k];
     if (!valid[k]) {
@@ -115,8 +122,13 @@ void SearchChunk(const MeshIndex& index, const BatchQuerySettings& settings,
     // The previous point's triangle, offered first, usually makes the
     // radius nearly exact at once.
     QueryPath path = QueryPath::kTree;
-    r = index.Closest(p[k], radius, settings.coherent_start ? prev_triangle : UINT32_MAX, &path);
+    const uint32_t hint = settings.coherent_start ? prev_triangle : UINT32_MAX;
+    r = index.Closest(p[k], radius, hint, &path, certify);
     ++paths[static_cast<int>(path)];
+    if (certify && hint != UINT32_MAX) {
+      certified += path != QueryPath::kTree;
+      if (++tried == kCertificateProbe && 4 * certified < tried) certify = false;
+    }
     // The bound holds exactly; this only guards against its rounding.
     if (!r.matched() && radius < max_d) r = index.Closest(p[k], max_d);
     if (r.matched()) {
