@@ -88,7 +88,7 @@ bool OfferTriangle(wide::Query& q, uint32_t t) {
                   false);
 }
 
-// Steps across the edges the best closest point lies on, at most this many
+// Steps across the edge or corner the best closest point lies on, at most this many
 // times: the scan points' hints are mostly one triangle off.
 constexpr int kMaxSteps = 2;
 
