@@ -17,8 +17,9 @@
 // Most queries need not even offer the ring: when the hint's closest point
 // lies inside its face, its rise (core/distance/hint_alone.h) proves that
 // no ring triangle is as close either, and the hint alone is the answer.
-// When it lies on an edge, the triangle across that edge is tried first
-// (it is likelier the answer), and the proof is asked of the better one.
+// When it lies on an edge or a corner, the triangles across that edge or
+// the corner's two edges are tried first (they are likelier the answer),
+// and the proof is asked of the best one.
 //
 // D(T) comes from one search of the BVH per triangle, from m, that skips
 // S(T)'s lanes and is capped at (1 + kCapRadii) r, r the largest distance
