@@ -107,15 +107,13 @@ bool OfferOutside(wide::Query& q, const wide::LeafBlock& block, int lane) {
   for (int j = 0; j < s.ring->blocks; ++j)
     if (s.ring->block[j] == b && (s.ring->lanes[j] >> lane & 1u)) return false;
   Eigen::Vector3d v[3];
-  for (int k = 0; k < 3; ++k)
-    v[k] = Eigen::Vector3d(block.vertex[k][0][lane], block.vertex[k][1][lane],
-                           block.vertex[k][2][lane]);
+  LaneVertices(block, lane, v);
   const double d2 =
       ClosestPointOnTriangle(s.m, v[0], v[1], v[2], static_cast<TriangleShape>(block.shape[lane]))
           .squared_distance;
   if (!(d2 < q.best_d2)) return false;
   q.best_d2 = d2;
-  q.box_radius2 = SearchRadius2(SearchRadius(std::sqrt(d2), s.coordinate_scale));
+  q.box_radius2 = SearchRadius2(std::sqrt(d2), s.coordinate_scale);
   return true;
 }
 
@@ -142,7 +140,7 @@ void SetReach(const WideBvh& bvh, const Eigen::Vector3d v[3], HintCertificate& c
   wide::Query q{{m.x(), m.y(), m.z()},
                 {mf.x(), mf.y(), mf.z()},
                 cap * cap,
-                SearchRadius2(SearchRadius(cap, scale)),
+                SearchRadius2(cap, scale),
                 LeafMargin(m),
                 &s,
                 &OfferOutside};

@@ -29,7 +29,7 @@ struct QueryState {
 
 // The float search radius for the best squared distance so far.
 float BoxRadius2(const wide::Query& q, const QueryState& s) {
-  return SearchRadius2(SearchRadius(std::sqrt(q.best_d2), s.coordinate_scale));
+  return SearchRadius2(std::sqrt(q.best_d2), s.coordinate_scale);
 }
 
 // The float radius and leaf margin a search culls with: from the best so
@@ -37,7 +37,7 @@ float BoxRadius2(const wide::Query& q, const QueryState& s) {
 void PrepareSearch(wide::Query& q, const QueryState& s, double max_distance_mm) {
   q.box_radius2 = s.best_triangle != UINT32_MAX
                       ? BoxRadius2(q, s)
-                      : SearchRadius2(SearchRadius(max_distance_mm, s.coordinate_scale));
+                      : SearchRadius2(max_distance_mm, s.coordinate_scale);
   q.leaf_margin = LeafMargin(s.p);
 }
 
@@ -67,9 +67,7 @@ bool OfferLane(wide::Query& q, const wide::LeafBlock& block, int lane) {
   // same distance, which is no improvement.
   if (block.triangle[lane] == s.best_triangle) return false;
   Eigen::Vector3d v[3];
-  for (int k = 0; k < 3; ++k)
-    v[k] = Eigen::Vector3d(block.vertex[k][0][lane], block.vertex[k][1][lane],
-                           block.vertex[k][2][lane]);
+  LaneVertices(block, lane, v);
   return Consider(
       q, s, block.triangle[lane],
       ClosestPointOnTriangle(s.p, v[0], v[1], v[2], static_cast<TriangleShape>(block.shape[lane])),

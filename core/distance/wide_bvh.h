@@ -108,10 +108,17 @@ inline float SearchRadius(double distance_mm, double coordinate_scale) {
   const double padded = distance_mm * (1 + 1e-6) + 1e-6 * coordinate_scale + 1e-9;
   return NextUp(static_cast<float>(padded));
 }
-// The radius squared, rounded up to a float (the double product is exact:
-// 48 bits).
-inline float SearchRadius2(float radius) {
+// SearchRadius squared, rounded up to a float (the double product is
+// exact: 48 bits): what a search culls boxes and lanes against.
+inline float SearchRadius2(double distance_mm, double coordinate_scale) {
+  const float radius = SearchRadius(distance_mm, coordinate_scale);
   return RoundUpToFloat(static_cast<double>(radius) * radius);
+}
+// A leaf lane's triangle: the mesh's float vertices, exactly, as doubles.
+inline void LaneVertices(const wide::LeafBlock& block, int lane, Eigen::Vector3d v[3]) {
+  for (int k = 0; k < 3; ++k)
+    v[k] = Eigen::Vector3d(block.vertex[k][0][lane], block.vertex[k][1][lane],
+                           block.vertex[k][2][lane]);
 }
 // A block with every lane unused.
 wide::LeafBlock EmptyLeafBlock();
