@@ -21,6 +21,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/distance/mesh_index.h"
 #include "core/types/cancel.h"
+#include "core/types/default_init_vector.h"
 #include "core/types/radix_sort.h"
 
 namespace surfinspect {
@@ -52,12 +53,12 @@ constexpr std::size_t kCancelStride = std::size_t{1} << 16;
 // input order). Invalid points go last. The codes are computed in parallel
 // blocks (each depends only on its point). The result holds code << 32 |
 // point index, in visiting order; empty if cancelled.
-std::vector<uint64_t> MortonOrder(const PointCloud& cloud, const std::atomic<bool>* cancel) {
+DefaultInitVector<uint64_t> MortonOrder(const PointCloud& cloud, const std::atomic<bool>* cancel) {
   const Bounds3 bounds = ComputeBounds(cloud);
   const std::size_t n = cloud.size();
   const double extent = bounds.empty() ? 0.0 : (bounds.max - bounds.min).maxCoeff();
   const double scale = extent > 0 ? 1023.0 / extent : 0.0;
-  std::vector<uint64_t> items(n);  // code << 32 | point index
+  DefaultInitVector<uint64_t> items(n);  // code << 32 | point index, written below
   std::atomic<bool> stopped{false};
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, n, kCancelStride),
@@ -152,7 +153,7 @@ absl::Status QueryClosestEach(const MeshIndex& index, const PointCloud& points,
   const auto t0 = std::chrono::steady_clock::now();
   tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
   // A grid is already coherent row by row; anything else gets Morton order.
-  std::vector<uint64_t> order;  // code << 32 | point index
+  DefaultInitVector<uint64_t> order;  // code << 32 | point index
   if (settings.coherent_start && !points.organized() && n <= UINT32_MAX) {
     arena.execute([&] { order = MortonOrder(points, cancel); });
     if (order.empty()) return absl::CancelledError("closest-point query cancelled");

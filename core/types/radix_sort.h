@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/types/default_init_vector.h"
+
 namespace surfinspect {
 
 // Sorts keys[i] (each < 2^key_bits) ascending and permutes values alongside;
@@ -20,7 +22,7 @@ bool RadixSortPairs(std::vector<uint64_t>& keys, std::vector<uint32_t>& values, 
 // The same for pairs packed as key << 32 | value (key < 2^key_bits,
 // key_bits <= 32), with 10-bit digits: half the bytes of the unpacked form
 // move per pass, and each pass writes to fewer places at once.
-bool RadixSortPacked(std::vector<uint64_t>& items, int key_bits,
+bool RadixSortPacked(DefaultInitVector<uint64_t>& items, int key_bits,
                      const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace surfinspect

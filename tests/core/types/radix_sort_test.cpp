@@ -51,7 +51,8 @@ TEST(RadixSort, PackedMatchesThePairSort) {
   for (int key_bits : {1, 11, 12, 31, 32})
     for (std::size_t n : {std::size_t{0}, std::size_t{3}, std::size_t{5000}, std::size_t{200000}}) {
       const uint64_t mask = (uint64_t{1} << key_bits) - 1;
-      std::vector<uint64_t> keys(n), packed(n);
+      std::vector<uint64_t> keys(n);
+      DefaultInitVector<uint64_t> packed(n);
       std::vector<uint32_t> values(n);
       for (std::size_t i = 0; i < n; ++i) {
         keys[i] = rng() & mask & (key_bits > 11 ? 0xfff0f : mask);
@@ -68,7 +69,7 @@ TEST(RadixSort, PackedMatchesThePairSort) {
 }
 
 TEST(RadixSort, PackedStopsWhenCancelled) {
-  std::vector<uint64_t> items = {uint64_t{3} << 32, uint64_t{1} << 32 | 1};
+  DefaultInitVector<uint64_t> items = {uint64_t{3} << 32, uint64_t{1} << 32 | 1};
   std::atomic<bool> cancel{true};
   EXPECT_FALSE(RadixSortPacked(items, 2, &cancel));
   cancel = false;
