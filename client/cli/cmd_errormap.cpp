@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "client/cell/cell_config.h"
 #include "client/cell/part_outputs.h"
@@ -250,7 +251,13 @@ void RunErrorMap(const ErrorMapArgs& a) {
                                     {"boundary_edges", topo.boundary_edges},
                                     {"nonmanifold_edges", topo.nonmanifold_edges},
                                     {"degenerate_triangles", mesh.CountDegenerate()}};
-  const PointCloud cloud_in_part = TransformCloud(cloud_in_world, world_from_part.inverse());
+  // Without --world-from-part the two frames are one: the same points,
+  // without a copy of the cloud, when the copy would be bit-identical.
+  const Eigen::Isometry3d part_from_world = world_from_part.inverse();
+  std::optional<PointCloud> moved;
+  if (!TransformKeepsCloud(cloud_in_world, part_from_world))
+    moved = TransformCloud(cloud_in_world, part_from_world);
+  const PointCloud& cloud_in_part = moved ? *moved : cloud_in_world;
   const TriangleMesh html_mesh = a.html.empty() ? TriangleMesh() : mesh;  // the local path takes it
   ErrorMapRun run = a.remote.remote()
                         ? RemoteErrorMap(a, cloud_in_world, world_from_part, mesh, plan)

@@ -5,9 +5,13 @@
 
 #include "client/cli/commands.h"
 #include "core/process/buffer_reuse.h"
+#include "core/process/huge_page_heap.h"
 
 int main(int argc, char** argv) {
   surfinspect::ReuseFreedLargeBuffers();  // clouds are ~10 MB buffers, over and over
+  // One command, 100+ MB of fresh buffers: faulted in 2 MiB pages where the
+  // kernel allows (core/process/huge_page_heap.h); no result depends on it.
+  surfinspect::BackHeapWithHugePages(surfinspect::kCliHeapReserveBytes);
   CLI::App app{
       "surfinspect: point-cloud filtering, calibration, registration and "
       "error maps against CAD (units: mm)"};

@@ -50,6 +50,14 @@ PointCloud TransformCloud(const PointCloud& cloud, const Eigen::Isometry3d& to_f
   return out;
 }
 
+bool TransformKeepsCloud(const PointCloud& cloud, const Eigen::Isometry3d& to_from) {
+  if (to_from.matrix() != Eigen::Matrix4d::Identity()) return false;
+  for (const Eigen::Vector3f& p : cloud.points)
+    for (int a = 0; a < 3; ++a)
+      if (p[a] == 0 && std::signbit(p[a])) return false;  // NaN pixels fail the first test
+  return true;
+}
+
 PoseDifference ComparePoses(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
   const Eigen::Isometry3d d = a.inverse() * b;
   const Eigen::AngleAxisd aa(d.linear());

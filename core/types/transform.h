@@ -27,6 +27,12 @@ absl::StatusOr<Eigen::Isometry3d> FromRowMajor(const RowMajor16& row_major, absl
 // organized grid stays organized. Computed in double, stored as float.
 PointCloud TransformCloud(const PointCloud& cloud, const Eigen::Isometry3d& to_from);
 
+// True when TransformCloud(cloud, to_from) would equal `cloud` bit for bit,
+// so a caller may use `cloud` itself and skip the copy: `to_from` is the
+// identity and no point has a -0 coordinate (the arithmetic, with its
+// +0 translation, writes +0 there).
+bool TransformKeepsCloud(const PointCloud& cloud, const Eigen::Isometry3d& to_from);
+
 // Rotation angle (degrees) and translation length (mm) of a - b's difference
 // a^-1 * b: the standard pose-error measure used in tests and reports.
 struct PoseDifference {

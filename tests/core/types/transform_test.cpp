@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 
 namespace surfinspect {
@@ -111,6 +112,35 @@ TEST(Transform, TransformCloudMapsValidPointsAndKeepsTheGrid) {
     }
     const Vector3d expected = r * grid.points[i].cast<double>() + t;  // x' = R x + t
     EXPECT_LT((out.points[i].cast<double>() - expected).norm(), 1e-4) << i;
+  }
+}
+
+// TransformKeepsCloud says true exactly when TransformCloud's output equals
+// its input bit for bit: the identity on a cloud with no -0 coordinate.
+TEST(Transform, TransformKeepsCloudExactlyWhenTheCopyWouldBeEqual) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<float> coord(-500.0f, 500.0f);
+  PointCloud grid = PointCloud::Organized(40, 30);
+  for (std::size_t i = 0; i < grid.size(); ++i)
+    if (i % 7 != 0)
+      grid.points[i] = Eigen::Vector3f(coord(rng), coord(rng), i % 5 ? coord(rng) : 0);
+  auto same_bits = [](const PointCloud& a, const PointCloud& b) {
+    return a.size() == b.size() &&
+           std::memcmp(a.points.data(), b.points.data(), a.size() * sizeof(a.points[0])) == 0;
+  };
+  const Isometry3d identity = Isometry3d::Identity();
+  const Isometry3d moved = RandomPose(rng);
+  EXPECT_TRUE(TransformKeepsCloud(grid, identity));
+  EXPECT_TRUE(same_bits(TransformCloud(grid, identity), grid));
+  // The identity as an inverse (what the CLI passes) is still the identity.
+  EXPECT_TRUE(TransformKeepsCloud(grid, identity.inverse()));
+  EXPECT_FALSE(TransformKeepsCloud(grid, moved));
+  EXPECT_FALSE(same_bits(TransformCloud(grid, moved), grid));
+  for (int axis = 0; axis < 3; ++axis) {
+    PointCloud signed_zero = grid;
+    signed_zero.points[3][axis] = -0.0f;
+    EXPECT_FALSE(TransformKeepsCloud(signed_zero, identity)) << axis;
+    EXPECT_FALSE(same_bits(TransformCloud(signed_zero, identity), signed_zero)) << axis;
   }
 }
 
