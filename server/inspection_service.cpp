@@ -100,6 +100,14 @@ class HeavyCall final : public grpc::ServerUnaryReactor {
 
 grpc::Status FromCore(const absl::Status& st) { return ToGrpc(st); }
 
+// The steps around the core calls (a cloud's conversion, the plan, the
+// response) do not poll; the work checks between them, so a call cancelled
+// there ends before the next step instead of finishing it.
+bool StopHere(const std::atomic<bool>& cancel) { return cancel.load(std::memory_order_relaxed); }
+grpc::Status CancelledBetweenSteps() {
+  return grpc::Status(grpc::StatusCode::CANCELLED, "cancelled between steps");
+}
+
 }  // namespace
 
 InspectionService::InspectionService(ServiceConfig config, Metrics* metrics)
@@ -251,6 +259,7 @@ grpc::ServerUnaryReactor* InspectionService::Filter(grpc::CallbackServerContext*
     LinkClusteringResult clusters;
     if (auto st = RemoveOutliers(*cloud, *settings, clusters, &cancel); !st.ok())
       return FromCore(st);
+    if (StopHere(cancel)) return CancelledBetweenSteps();
     wire::FilterResultToProto(*cloud, clusters, resp);
     return FitsOneMessage(*resp, "Filter response");
   });
@@ -356,6 +365,7 @@ grpc::ServerUnaryReactor* InspectionService::ErrorMap(grpc::CallbackServerContex
     if (!map.ok()) return FromCore(map.status());
     auto outcome = EvaluatePlan(*map, *cloud, part->mesh(), *plan, settings->threads);
     if (!outcome.ok()) return FromCore(outcome.status());
+    if (StopHere(cancel)) return CancelledBetweenSteps();
     wire::ErrorMapToProto(*map, *settings, *outcome, req->return_deviations(), resp);
     if (req->return_png()) {
       auto png = ErrorMapPngBytes(*cloud, *world_from_part, *map, part->mesh(), *outcome);

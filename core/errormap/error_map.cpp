@@ -13,22 +13,6 @@
 namespace surfinspect {
 namespace {
 
-// n copies of `value`, written slice by slice with `cancel` polled between
-// slices: first-touching the ~20 bytes per point of results costs 0.1-0.3 s
-// of page faults on 10^7 points here, longer than a cancelled call may run.
-template <typename T>
-bool FillUnlessCancelled(std::vector<T>& v, std::size_t n, const T& value,
-                         const std::atomic<bool>* cancel) {
-  constexpr std::size_t kSlice = std::size_t{1} << 18;
-  v.clear();
-  v.reserve(n);
-  for (std::size_t i = 0; i < n; i += kSlice) {
-    if (IsCancelled(cancel)) return false;
-    v.insert(v.end(), std::min(kSlice, n - i), value);
-  }
-  return true;
-}
-
 // In double, in the vector's order, whatever its element type.
 template <typename T>
 ComponentStats Summarize(const std::vector<T>& values) {

@@ -7,6 +7,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/filter/link_clustering_grid.h"
 #include "core/filter/link_clustering_unorganized.h"
+#include "core/types/cancel.h"
 
 namespace surfinspect {
 namespace {
@@ -114,6 +115,7 @@ absl::StatusOr<PointCloud> ApplyFilter(const PointCloud& cloud,
 absl::Status RemoveOutliers(PointCloud& cloud, const LinkClusteringSettings& settings,
                             LinkClusteringResult& result, const std::atomic<bool>* cancel) {
   if (auto st = ClusterLinksInto(cloud, settings, result, cancel); !st.ok()) return st;
+  if (IsCancelled(cancel)) return absl::CancelledError("link clustering: cancelled");
   SetRemovedToNaN(result, cloud);
   return absl::OkStatus();
 }

@@ -13,11 +13,10 @@ constexpr std::size_t kCancelStride = std::size_t{1} << 16;
 
 // Where each digit's run starts after a stable pass on the digit at `shift`
 // (an exclusive prefix sum of the digit counts).
-template <typename Keys>
-void DigitStarts(const Keys& keys, int shift, std::vector<std::size_t>& start) {
+void DigitStarts(const uint64_t* keys, std::size_t n, int shift, std::vector<std::size_t>& start) {
   const std::size_t mask = start.size() - 1;
   std::fill(start.begin(), start.end(), 0);
-  for (uint64_t k : keys) ++start[(k >> shift) & mask];
+  for (std::size_t i = 0; i < n; ++i) ++start[(keys[i] >> shift) & mask];
   std::size_t sum = 0;
   for (auto& s : start) sum += std::exchange(s, sum);
 }
@@ -29,19 +28,30 @@ bool RadixSortPairs(std::vector<uint64_t>& keys, std::vector<uint32_t>& values, 
   constexpr int kDigitBits = 11;
   constexpr std::size_t kBuckets = std::size_t{1} << kDigitBits;
   if (key_bits <= 0) return !IsCancelled(cancel);
-  std::vector<uint64_t> keys_tmp(keys.size());
-  std::vector<uint32_t> values_tmp(values.size());
+  const std::size_t n = keys.size();
+  // Every pass writes every slot, so the scratch starts unwritten: its pages
+  // are first touched in the first pass, which polls, instead of in a
+  // serial zeroing that cannot (core/types/default_init_vector.h).
+  DefaultInitVector<uint64_t> keys_tmp(n);
+  DefaultInitVector<uint32_t> values_tmp(n);
+  uint64_t *from_keys = keys.data(), *to_keys = keys_tmp.data();
+  uint32_t *from_values = values.data(), *to_values = values_tmp.data();
   std::vector<std::size_t> start(kBuckets);
   for (int shift = 0; shift < key_bits; shift += kDigitBits) {
-    DigitStarts(keys, shift, start);
-    for (std::size_t i = 0; i < keys.size(); ++i) {
+    DigitStarts(from_keys, n, shift, start);
+    for (std::size_t i = 0; i < n; ++i) {
       if (i % kCancelStride == 0 && IsCancelled(cancel)) return false;
-      const std::size_t to = start[(keys[i] >> shift) & (kBuckets - 1)]++;
-      keys_tmp[to] = keys[i];
-      values_tmp[to] = values[i];
+      const std::size_t to = start[(from_keys[i] >> shift) & (kBuckets - 1)]++;
+      to_keys[to] = from_keys[i];
+      to_values[to] = from_values[i];
     }
-    keys.swap(keys_tmp);
-    values.swap(values_tmp);
+    std::swap(from_keys, to_keys);
+    std::swap(from_values, to_values);
+  }
+  // After an odd number of passes the sorted pairs are in the scratch.
+  if (from_keys != keys.data()) {
+    std::copy(from_keys, from_keys + n, keys.data());
+    std::copy(from_values, from_values + n, values.data());
   }
   return true;
 }
@@ -58,7 +68,7 @@ bool RadixSortPacked(DefaultInitVector<uint64_t>& items, int key_bits,
   DefaultInitVector<uint64_t> tmp(items.size());
   std::vector<std::size_t> start(kBuckets);
   for (int shift = 32; shift < 32 + key_bits; shift += kDigitBits) {
-    DigitStarts(items, shift, start);
+    DigitStarts(items.data(), items.size(), shift, start);
     for (std::size_t i = 0; i < items.size(); ++i) {
       if (i % kCancelStride == 0 && IsCancelled(cancel)) return false;
       tmp[start[(items[i] >> shift) & (kBuckets - 1)]++] = items[i];
