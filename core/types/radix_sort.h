@@ -15,7 +15,7 @@ namespace surfinspect {
 // Sorts keys[i] (each < 2^key_bits) ascending and permutes values alongside;
 // equal keys keep their input order. keys and values have the same size.
 // Polls `cancel` every 2^16 elements of each pass and returns false when it
-// is set (the pairs are then in an unspecified order); true otherwise.
+// is set (keys and values then hold unspecified contents); true otherwise.
 bool RadixSortPairs(std::vector<uint64_t>& keys, std::vector<uint32_t>& values, int key_bits,
                     const std::atomic<bool>* cancel = nullptr);
 
