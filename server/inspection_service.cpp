@@ -324,7 +324,7 @@ grpc::ServerUnaryReactor* InspectionService::Register(grpc::CallbackServerContex
         }
         if (req->filter())
           if (auto st = FilterViews(views, *filter, &cancel); !st.ok()) return FromCore(st);
-        auto merged = RegisterToWorld(views);
+        auto merged = RegisterToWorld(views, &cancel);
         if (!merged.ok()) return FromCore(merged.status());
         if (req->best_fit()) {
           auto world_from_part =
@@ -338,6 +338,7 @@ grpc::ServerUnaryReactor* InspectionService::Register(grpc::CallbackServerContex
           merged->cloud_in_world = TransformCloud(merged->cloud_in_world, fit->correction);
           wire::TransformToProto(fit->correction, resp->mutable_best_fit_correction());
         }
+        if (StopHere(cancel)) return CancelledBetweenSteps();
         wire::MergedCloudToProto(*merged, resp);
         return FitsOneMessage(*resp, "Register response");
       });

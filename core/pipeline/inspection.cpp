@@ -33,7 +33,7 @@ absl::StatusOr<InspectionResult> InspectPart(const MeshIndex& part,
     if (auto st = FilterViews(views, settings.filter_settings, cancel, on_view); !st.ok())
       return st;
   }
-  auto merged = RegisterToWorld(views);
+  auto merged = RegisterToWorld(views, cancel);
   if (!merged.ok()) return merged.status();
   out.merged = *std::move(merged);
   if (progress)

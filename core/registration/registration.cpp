@@ -1,6 +1,7 @@
 #include "core/registration/registration.h"
 
 #include "absl/strings/str_cat.h"
+#include "core/types/cancel.h"
 #include "core/types/transform.h"
 
 namespace surfinspect {
@@ -16,7 +17,8 @@ absl::Status FilterViews(std::vector<ViewScan>& views, const LinkClusteringSetti
   return absl::OkStatus();
 }
 
-absl::StatusOr<MergedCloud> RegisterToWorld(const std::vector<ViewScan>& views) {
+absl::StatusOr<MergedCloud> RegisterToWorld(const std::vector<ViewScan>& views,
+                                            const std::atomic<bool>* cancel) {
   if (views.empty()) return absl::InvalidArgumentError("register: no views");
   if (views.size() > 65535) return absl::InvalidArgumentError("register: more than 65535 views");
   MergedCloud out;
@@ -36,6 +38,7 @@ absl::StatusOr<MergedCloud> RegisterToWorld(const std::vector<ViewScan>& views) 
   out.view_id.reserve(total);
   out.grid_index.reserve(total);
   for (std::size_t k = 0; k < views.size(); ++k) {
+    if (IsCancelled(cancel)) return absl::CancelledError("register: cancelled");
     const ViewScan& v = views[k];
     out.view_names.push_back(v.name);
     const std::size_t before = pts.size();

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+
 #include "core/simulation/demo_cell.h"
 #include "core/types/transform.h"
 
@@ -77,6 +79,21 @@ TEST(RegistrationInput, RejectsBadViews) {
   ViewScan broken{"v2", PointCloud::Organized(2, 2), Eigen::Isometry3d::Identity()};
   broken.cloud_in_sensor.points.pop_back();
   EXPECT_FALSE(RegisterToWorld({broken}).ok());
+}
+
+// Raised before the call, the flag stops it before the first view; lowered,
+// the same views merge.
+TEST(RegistrationInput, StopsWhenCancelled) {
+  PointCloud c = PointCloud::Organized(2, 1);
+  c.points = {Eigen::Vector3f(1, 2, 3), Eigen::Vector3f(4, 5, 6)};
+  const std::vector<ViewScan> views = {{"v1", c, Eigen::Isometry3d::Identity()},
+                                       {"v2", c, Eigen::Isometry3d::Identity()}};
+  std::atomic<bool> cancel{true};
+  EXPECT_EQ(RegisterToWorld(views, &cancel).status().code(), absl::StatusCode::kCancelled);
+  cancel = false;
+  auto merged = RegisterToWorld(views, &cancel);
+  ASSERT_TRUE(merged.ok()) << merged.status();
+  EXPECT_EQ(merged->cloud_in_world.size(), 4u);
 }
 
 }  // namespace
