@@ -44,10 +44,6 @@ uint64_t Spread10(uint64_t v) {
   return v;
 }
 
-// Polled every this many points in the passes below, so a
-// cancelled call stops within milliseconds even on 10^7 points.
-constexpr std::size_t kCancelStride = std::size_t{1} << 16;
-
 // Visiting order for an unorganized cloud: 30-bit Morton codes on a 1024^3
 // grid over the bounds, sorted by a stable radix sort (equal codes keep
 // input order). Invalid points go last. The codes are computed in parallel

@@ -17,13 +17,6 @@ namespace {
 
 constexpr int32_t kInvalid = LinkClusteringResult::kInvalid;
 constexpr int kMaxAxisBits = 21;  // 3 x 21 bits fit one uint64 key
-// The per-point passes poll for cancellation every this many points: a
-// cancelled call on 5 * 10^6 points stops within milliseconds.
-constexpr std::size_t kCancelStride = std::size_t{1} << 16;
-
-bool CancelledAt(std::size_t i, const std::atomic<bool>* cancel) {
-  return i % kCancelStride == 0 && IsCancelled(cancel);
-}
 
 // Bits needed to hold values 0..v.
 int BitsFor(uint64_t v) {

@@ -14,6 +14,15 @@ inline bool IsCancelled(const std::atomic<bool>* cancel) {
   return cancel != nullptr && cancel->load(std::memory_order_relaxed);
 }
 
+// Per-item passes poll every this many items: at up to a few hundred ns an
+// item, a cancelled call on 10^7 points stops within milliseconds.
+constexpr std::size_t kCancelStride = std::size_t{1} << 16;
+
+// IsCancelled at every kCancelStride-th item `i` of a pass; false between.
+inline bool CancelledAt(std::size_t i, const std::atomic<bool>* cancel) {
+  return i % kCancelStride == 0 && IsCancelled(cancel);
+}
+
 // Sets `v` to n copies of `value`, written slice by slice with `cancel`
 // polled between slices; false (and `v` partly filled) when cancelled. A
 // fresh buffer's first touch costs about 3 ms of page faults per MB on this

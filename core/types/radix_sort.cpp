@@ -9,8 +9,6 @@
 namespace surfinspect {
 namespace {
 
-constexpr std::size_t kCancelStride = std::size_t{1} << 16;
-
 // Where each digit's run starts after a stable pass on the digit at `shift`
 // (an exclusive prefix sum of the digit counts).
 void DigitStarts(const uint64_t* keys, std::size_t n, int shift, std::vector<std::size_t>& start) {
@@ -40,7 +38,7 @@ bool RadixSortPairs(std::vector<uint64_t>& keys, std::vector<uint32_t>& values, 
   for (int shift = 0; shift < key_bits; shift += kDigitBits) {
     DigitStarts(from_keys, n, shift, start);
     for (std::size_t i = 0; i < n; ++i) {
-      if (i % kCancelStride == 0 && IsCancelled(cancel)) return false;
+      if (CancelledAt(i, cancel)) return false;
       const std::size_t to = start[(from_keys[i] >> shift) & (kBuckets - 1)]++;
       to_keys[to] = from_keys[i];
       to_values[to] = from_values[i];
@@ -70,7 +68,7 @@ bool RadixSortPacked(DefaultInitVector<uint64_t>& items, int key_bits,
   for (int shift = 32; shift < 32 + key_bits; shift += kDigitBits) {
     DigitStarts(items.data(), items.size(), shift, start);
     for (std::size_t i = 0; i < items.size(); ++i) {
-      if (i % kCancelStride == 0 && IsCancelled(cancel)) return false;
+      if (CancelledAt(i, cancel)) return false;
       tmp[start[(items[i] >> shift) & (kBuckets - 1)]++] = items[i];
     }
     items.swap(tmp);
