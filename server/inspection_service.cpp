@@ -13,6 +13,7 @@
 #include "core/pipeline/inspection.h"
 #include "core/registration/calibration.h"
 #include "core/registration/registration.h"
+#include "core/types/cancel.h"
 #include "core/types/transform.h"
 #include "server/cancel_signal.h"
 #include "server/guarded.h"
@@ -101,9 +102,8 @@ class HeavyCall final : public grpc::ServerUnaryReactor {
 grpc::Status FromCore(const absl::Status& st) { return ToGrpc(st); }
 
 // The steps around the core calls (a cloud's conversion, the plan, the
-// response) do not poll; the work checks between them, so a call cancelled
-// there ends before the next step instead of finishing it.
-bool StopHere(const std::atomic<bool>& cancel) { return cancel.load(std::memory_order_relaxed); }
+// response) do not poll; the work checks IsCancelled between them, so a call
+// cancelled there ends before the next step instead of finishing it.
 grpc::Status CancelledBetweenSteps() {
   return grpc::Status(grpc::StatusCode::CANCELLED, "cancelled between steps");
 }
@@ -259,7 +259,7 @@ grpc::ServerUnaryReactor* InspectionService::Filter(grpc::CallbackServerContext*
     LinkClusteringResult clusters;
     if (auto st = RemoveOutliers(*cloud, *settings, clusters, &cancel); !st.ok())
       return FromCore(st);
-    if (StopHere(cancel)) return CancelledBetweenSteps();
+    if (IsCancelled(&cancel)) return CancelledBetweenSteps();
     wire::FilterResultToProto(*cloud, clusters, resp);
     return FitsOneMessage(*resp, "Filter response");
   });
@@ -338,7 +338,7 @@ grpc::ServerUnaryReactor* InspectionService::Register(grpc::CallbackServerContex
           merged->cloud_in_world = TransformCloud(merged->cloud_in_world, fit->correction);
           wire::TransformToProto(fit->correction, resp->mutable_best_fit_correction());
         }
-        if (StopHere(cancel)) return CancelledBetweenSteps();
+        if (IsCancelled(&cancel)) return CancelledBetweenSteps();
         wire::MergedCloudToProto(*merged, resp);
         return FitsOneMessage(*resp, "Register response");
       });
@@ -366,7 +366,7 @@ grpc::ServerUnaryReactor* InspectionService::ErrorMap(grpc::CallbackServerContex
     if (!map.ok()) return FromCore(map.status());
     auto outcome = EvaluatePlan(*map, *cloud, part->mesh(), *plan, settings->threads);
     if (!outcome.ok()) return FromCore(outcome.status());
-    if (StopHere(cancel)) return CancelledBetweenSteps();
+    if (IsCancelled(&cancel)) return CancelledBetweenSteps();
     wire::ErrorMapToProto(*map, *settings, *outcome, req->return_deviations(), resp);
     if (req->return_png()) {
       auto png = ErrorMapPngBytes(*cloud, *world_from_part, *map, part->mesh(), *outcome);
