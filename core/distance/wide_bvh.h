@@ -28,6 +28,7 @@
 
 namespace surfinspect {
 
+// Embree's build quality for ours (kHigh: binned SAH).
 RTCBuildQuality EmbreeBuildQuality(BvhQuality quality);
 // "sse2" or "avx2"; kAuto resolves first.
 const char* SearchIsaName(SearchIsa isa);
