@@ -19,6 +19,7 @@ namespace {
 
 using link_row::kNone;
 using link_row::NextBit;
+using link_row::NextBitUpTo;
 using link_row::RowMasks;
 using link_row::RowSoA;
 
@@ -67,16 +68,17 @@ struct GridScratch {
 // of its pixels links to along the row's north-west, north and north-east
 // masks. run_above[c] is the run of column c in the row above, an index
 // into `above` and, plus `offset`, into the forest.
-void MergeWithRunsAbove(const uint64_t* const vertical[3], uint32_t words, int32_t id, uint32_t s,
-                        uint32_t e, uint32_t width, bool eight, const int32_t* run_above,
-                        const Run* above, int32_t offset, UnionFind& forest) {
+void MergeWithRunsAbove(const uint64_t* const vertical[3], int32_t id, uint32_t s, uint32_t e,
+                        uint32_t width, bool eight, const int32_t* run_above, const Run* above,
+                        int32_t offset, UnionFind& forest) {
   const int offsets[3] = {-1, 0, 1};  // north-west, north, north-east
   const bool use[3] = {eight, true, eight};
   for (int k = 0; k < 3; ++k) {
     if (!use[k]) continue;
     // All pixels up to the end of a run above (shifted by the offset)
     // reach that same run: merge once, then skip past it.
-    for (uint32_t c = NextBit(vertical[k], words, s); c <= e; c = NextBit(vertical[k], words, c)) {
+    for (uint32_t c = NextBitUpTo(vertical[k], s, e); c != kNone;
+         c = NextBitUpTo(vertical[k], c, e)) {
       const int32_t run_up = run_above[c + offsets[k]];
       forest.Union(id, run_up + offset);
       const int64_t past = int64_t{above[run_up].last_col} - offsets[k] + 1;
@@ -124,7 +126,7 @@ absl::Status LabelRow(const PointCloud& cloud, uint32_t r, uint32_t band_first, 
     link_row::Bounds(cur, s, e, g.runs.back().lo, g.runs.back().hi);
     std::fill(run_here.begin() + s, run_here.begin() + e + 1, id);
     if (merge)
-      MergeWithRunsAbove(vertical, g.words, id, s, e, w, eight, run_above.data(), g.runs.data(), 0,
+      MergeWithRunsAbove(vertical, id, s, e, w, eight, run_above.data(), g.runs.data(), 0,
                          g.forest);
   }
   return absl::OkStatus();
@@ -182,10 +184,9 @@ UnionFind JoinBands(std::vector<Band>& bands, uint32_t width, bool eight) {
                                          &band.seam[2 * std::size_t{words}]};
     const Band& above = bands[b - 1];
     for (std::size_t i = 0; i < band.first_row_runs; ++i)
-      MergeWithRunsAbove(vertical, words, static_cast<int32_t>(band.offset + i),
-                         band.runs[i].first_col, band.runs[i].last_col, width, eight,
-                         above.last_row_runs.data(), above.runs.data(),
-                         static_cast<int32_t>(above.offset), forest);
+      MergeWithRunsAbove(vertical, static_cast<int32_t>(band.offset + i), band.runs[i].first_col,
+                         band.runs[i].last_col, width, eight, above.last_row_runs.data(),
+                         above.runs.data(), static_cast<int32_t>(above.offset), forest);
   }
   return forest;
 }

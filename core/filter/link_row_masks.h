@@ -7,6 +7,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -65,7 +66,32 @@ inline uint32_t NextBit(const uint64_t* bits, uint32_t words, uint32_t from) {
   return 64 * k + static_cast<uint32_t>(__builtin_ctzll(w));
 }
 
+// The first set bit at index in [from, last], or kNone. Unlike NextBit it
+// reads no word past last's: a run's vertical links end at the run.
+inline uint32_t NextBitUpTo(const uint64_t* bits, uint32_t from, uint32_t last) {
+  uint32_t k = from / 64;
+  const uint32_t k_last = last / 64;
+  if (from > last) return kNone;
+  uint64_t w = bits[k] & (~uint64_t{0} << (from % 64));
+  while (w == 0) {
+    if (++k > k_last) return kNone;
+    w = bits[k];
+  }
+  const uint32_t c = 64 * k + static_cast<uint32_t>(__builtin_ctzll(w));
+  return c <= last ? c : kNone;
+}
+
 // Bounds of the pixels first..last of the row, which must all be valid.
-void Bounds(const RowSoA& row, uint32_t first, uint32_t last, float lo[3], float hi[3]);
+void BoundsOfLongRun(const RowSoA& row, uint32_t first, uint32_t last, float lo[3], float hi[3]);
+inline void Bounds(const RowSoA& row, uint32_t first, uint32_t last, float lo[3], float hi[3]) {
+  if (last - first >= 8) return BoundsOfLongRun(row, first, last, lo, hi);
+  // Most runs of a scan are a pixel or two of an outlier: inline, scalar.
+  for (int a = 0; a < 3; ++a) lo[a] = hi[a] = row.c(a)[first];
+  for (uint32_t i = first + 1; i <= last; ++i)
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], row.c(a)[i]);
+      hi[a] = std::max(hi[a], row.c(a)[i]);
+    }
+}
 
 }  // namespace surfinspect::link_row
