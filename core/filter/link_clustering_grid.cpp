@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -144,7 +145,14 @@ struct Band {
   std::size_t first_row_runs = 0;
   std::size_t offset = 0;  // of its first run among all, set by the join
   absl::Status status;
+  // Pass 2: its components' count and first id, and its runs (band-local
+  // indices) whose component starts in an earlier band.
+  std::size_t roots = 0, first_id = 0;
+  std::vector<uint32_t> foreign;
 };
+
+// Runs work(band) for every band, in parallel.
+using EachBand = std::function<void(const std::function<void(Band&)>&)>;
 
 void LabelBand(const PointCloud& cloud, float r2, bool eight, const std::atomic<bool>* cancel,
                Band& band) {
@@ -191,39 +199,83 @@ UnionFind JoinBands(std::vector<Band>& bands, uint32_t width, bool eight) {
   return forest;
 }
 
-// Pass 2: ids in raster order of each component's first run (parent[r] <=
-// r, so the entry r points to already holds its final id) and statistics.
-// On return parent[i] is run i's component id.
-void NumberComponents(const std::vector<Band>& bands, std::vector<int32_t>& parent,
-                      LinkClusteringResult& result) {
-  auto& clusters = result.clusters;
-  clusters.clear();
-  std::size_t i = 0;
+// Adds a run to its component's statistics; `first` when it is the
+// component's first run (in raster order, as every fold is).
+void Fold(const Run& run, bool first, ClusterInfo& k) {
+  if (first) {
+    k = ClusterInfo();
+    k.min_row = k.max_row = run.row;
+    k.min_col = run.first_col;
+    k.max_col = run.last_col;
+    k.min = run.min();
+    k.max = run.max();
+  }
+  k.size += run.last_col - run.first_col + 1;
+  k.max_row = run.row;
+  k.min_col = std::min(k.min_col, run.first_col);
+  k.max_col = std::max(k.max_col, run.last_col);
+  k.min = k.min.cwiseMin(run.min());
+  k.max = k.max.cwiseMax(run.max());
+}
+
+// Pass 2a, one band: its roots (parent[i] == i: a component's first run)
+// numbered in raster order within the band.
+void NumberRoots(Band& band, const std::vector<int32_t>& parent, std::vector<int32_t>& local_id) {
+  band.roots = 0;
+  for (std::size_t i = band.offset; i < band.offset + band.runs.size(); ++i)
+    if (parent[i] == static_cast<int32_t>(i)) local_id[i] = static_cast<int32_t>(band.roots++);
+}
+
+// Pass 2b, one band: each run's component id (ids in raster order of each
+// component's first run) and the statistics of the components that start
+// in this band. A run whose component starts in an earlier band is kept in
+// band.foreign, folded afterwards in band order: every component is then
+// folded in raster order, as by one serial pass, and no two threads write
+// the same component.
+void NumberRuns(Band& band, const std::vector<Band>& bands, const std::vector<int32_t>& parent,
+                const std::vector<int32_t>& local_id, std::vector<int32_t>& component,
+                std::vector<ClusterInfo>& clusters) {
+  band.foreign.clear();
+  for (std::size_t j = 0; j < band.runs.size(); ++j) {
+    const std::size_t i = band.offset + j;
+    int32_t root = parent[i];
+    while (parent[static_cast<std::size_t>(root)] != root) root = parent[root];
+    const auto r = static_cast<std::size_t>(root);
+    const bool here = r >= band.offset;
+    const Band& owner =
+        here ? band
+             : *(std::upper_bound(bands.begin(), bands.end(), r,
+                                  [](std::size_t run, const Band& b) { return run < b.offset; }) -
+                 1);
+    const int32_t id = static_cast<int32_t>(owner.first_id) + local_id[r];
+    component[i] = id;
+    if (here)
+      Fold(band.runs[j], r == i, clusters[static_cast<std::size_t>(id)]);
+    else
+      band.foreign.push_back(static_cast<uint32_t>(j));
+  }
+}
+
+// Pass 2: numbers the components and folds their statistics (2a, 2b, then
+// the foreign runs of each band in band order). Returns each run's id.
+std::vector<int32_t> NumberComponents(std::vector<Band>& bands, const std::vector<int32_t>& parent,
+                                      const EachBand& each_band, LinkClusteringResult& result) {
+  std::vector<int32_t> local_id(parent.size()), component(parent.size());
+  each_band([&](Band& band) { NumberRoots(band, parent, local_id); });
+  std::size_t total = 0;
+  for (Band& band : bands) {
+    band.first_id = total;
+    total += band.roots;
+  }
+  result.clusters.resize(total);
+  each_band(
+      [&](Band& band) { NumberRuns(band, bands, parent, local_id, component, result.clusters); });
   for (const Band& band : bands)
-    for (const Run& run : band.runs) {
-      int32_t id;
-      if (parent[i] == static_cast<int32_t>(i)) {
-        id = static_cast<int32_t>(clusters.size());
-        ClusterInfo k;
-        k.min_row = k.max_row = run.row;
-        k.min_col = run.first_col;
-        k.max_col = run.last_col;
-        k.min = run.min();
-        k.max = run.max();
-        clusters.push_back(k);
-      } else {
-        id = parent[parent[i]];
-      }
-      parent[i] = id;
-      ClusterInfo& k = clusters[static_cast<std::size_t>(id)];
-      k.size += run.last_col - run.first_col + 1;
-      k.max_row = run.row;
-      k.min_col = std::min(k.min_col, run.first_col);
-      k.max_col = std::max(k.max_col, run.last_col);
-      k.min = k.min.cwiseMin(run.min());
-      k.max = k.max.cwiseMax(run.max());
-      ++i;
+    for (uint32_t j : band.foreign) {
+      const auto id = static_cast<std::size_t>(component[band.offset + j]);
+      Fold(band.runs[j], false, result.clusters[id]);
     }
+  return component;
 }
 
 // Pass 3: one band's labels and kept mask, written as spans of its runs.
@@ -260,7 +312,7 @@ absl::Status ClusterLinksOrganized(const PointCloud& cloud, const LinkClustering
     bands[b].first = static_cast<uint32_t>(b * kBandRows);
     bands[b].end = std::min(cloud.height, static_cast<uint32_t>((b + 1) * kBandRows));
   }
-  auto each_band = [&bands](auto&& work) {
+  const EachBand each_band = [&bands](const std::function<void(Band&)>& work) {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, bands.size(), 1),
                       [&](const tbb::blocked_range<std::size_t>& range) {
                         for (std::size_t b = range.begin(); b != range.end(); ++b) work(bands[b]);
@@ -270,13 +322,12 @@ absl::Status ClusterLinksOrganized(const PointCloud& cloud, const LinkClustering
   // The first failing band in row order has the first failing row.
   for (const Band& band : bands)
     if (!band.status.ok()) return band.status;
-  UnionFind forest = JoinBands(bands, cloud.width, eight);
+  const std::vector<int32_t> parent = JoinBands(bands, cloud.width, eight).ReleaseParents();
   result.input_points = cloud.size();
   result.organized_path = true;
   result.labels.resize(cloud.size());
   result.kept_mask.resize(cloud.size());
-  std::vector<int32_t> component = std::move(forest).ReleaseParents();
-  NumberComponents(bands, component, result);
+  const std::vector<int32_t> component = NumberComponents(bands, parent, each_band, result);
   internal::DecideClusters(settings, result);
   each_band([&](Band& band) { WriteBand(band, component, cloud.width, result); });
   return absl::OkStatus();
