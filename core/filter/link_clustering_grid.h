@@ -11,10 +11,15 @@
 // touching run above (bit scans skip the rest), so the per-pixel work is a
 // handful of vector instructions. Bands of 64 rows are labelled in parallel
 // and joined where each band's first row meets the row above it; the union
-// makes the smaller run the root, so the forest is the serial pass's. The
-// second pass walks the runs in raster order and numbers the components;
-// the third writes labels and the kept mask as filled spans, band by band
-// in parallel. No per-point heap allocation; scratch is O(width + runs).
+// makes the smaller run the root, so the forest is the serial pass's
+// (grid_bands.h). The second pass numbers the components in raster order of
+// their first runs, band by band in parallel: each band counts its roots,
+// then gives each run its component's id and folds the run into the
+// statistics of components that begin in the band; runs of components begun
+// in an earlier band are folded afterwards, in band order, so every fold is
+// in raster order. The third writes labels and the kept mask as filled
+// spans, band by band in parallel. No per-point heap allocation; scratch is
+// O(width + runs).
 #pragma once
 
 #include <atomic>

@@ -1,0 +1,166 @@
+#include "core/filter/grid_bands.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "core/filter/link_row_masks.h"
+#include "core/types/cancel.h"
+
+namespace surfinspect::grid {
+namespace {
+
+using link_row::kNone;
+using link_row::NextBit;
+using link_row::NextBitUpTo;
+using link_row::RowMasks;
+using link_row::RowSoA;
+
+// Pass-1 state: two rows of structure-of-arrays and of run ids (this row
+// and the one above), the link masks of the current row, and the runs with
+// their union-find.
+struct GridScratch {
+  GridScratch(uint32_t width, uint32_t height)
+      : words((width + 63) / 64),
+        rows{RowSoA(64 * words), RowSoA(64 * words)},
+        masks(7 * std::size_t{words}),
+        run_of{std::vector<int32_t>(width), std::vector<int32_t>(width)} {
+    // The demo scan has about 30 runs a row; the reserve avoids regrowing.
+    runs.reserve(32 * std::size_t{height});
+    forest.Reserve(32 * std::size_t{height});
+  }
+  const uint32_t words;
+  RowSoA rows[2];
+  // Masks: valid, west, north-west, north, north-east, run starts, run ends.
+  std::vector<uint64_t> masks;
+  RowMasks m() {
+    return {masks.data(), masks.data() + words, masks.data() + 2 * words, masks.data() + 3 * words,
+            masks.data() + 4 * words};
+  }
+  uint64_t* starts() { return masks.data() + 5 * words; }
+  uint64_t* ends() { return masks.data() + 6 * words; }
+  std::vector<int32_t> run_of[2];
+  std::vector<Run> runs;
+  UnionFind forest;  // over run indices
+};
+
+// Merges run `id` (columns s..e of its row) with every run above that one
+// of its pixels links to along the row's north-west, north and north-east
+// masks. run_above[c] is the run of column c in the row above, an index
+// into `above` and, plus `offset`, into the forest.
+void MergeWithRunsAbove(const uint64_t* const vertical[3], int32_t id, uint32_t s, uint32_t e,
+                        uint32_t width, bool eight, const int32_t* run_above, const Run* above,
+                        int32_t offset, UnionFind& forest) {
+  // Most runs are a single outlier pixel, linked to nothing above: one test.
+  if (s / 64 == e / 64) {
+    const uint32_t k = s / 64;
+    const uint64_t in_run = (~uint64_t{0} >> (63 - e % 64)) & (~uint64_t{0} << (s % 64));
+    const uint64_t up = vertical[1][k] | (eight ? vertical[0][k] | vertical[2][k] : 0);
+    if ((up & in_run) == 0) return;
+  }
+  const int offsets[3] = {-1, 0, 1};  // north-west, north, north-east
+  const bool use[3] = {eight, true, eight};
+  for (int k = 0; k < 3; ++k) {
+    if (!use[k]) continue;
+    // All pixels up to the end of a run above (shifted by the offset)
+    // reach that same run: merge once, then skip past it.
+    for (uint32_t c = NextBitUpTo(vertical[k], s, e); c != kNone;
+         c = NextBitUpTo(vertical[k], c, e)) {
+      const int32_t run_up = run_above[c + offsets[k]];
+      forest.Union(id, run_up + offset);
+      const int64_t past = int64_t{above[run_up].last_col} - offsets[k] + 1;
+      c = static_cast<uint32_t>(std::max<int64_t>(c + 1, past));
+      if (c >= width) break;
+    }
+  }
+}
+
+// Pass 1 for row r: transposes it, computes its link masks, appends its runs
+// and, unless r is its band's first row, merges them with the linked runs of
+// the row above. A band's first row below another keeps its vertical masks
+// for the join instead (`seam`, 3 * words).
+absl::Status LabelRow(const PointCloud& cloud, uint32_t r, uint32_t band_first, float r2,
+                      bool eight, GridScratch& g, std::vector<uint64_t>& seam) {
+  const uint32_t w = cloud.width, h = cloud.height;
+  RowSoA& cur = g.rows[r & 1];
+  const RowSoA& up = g.rows[(r + 1) & 1];
+  link_row::Transpose(&cloud.points[std::size_t{r} * w], w, cur);
+  if (r + 1 < h) {
+    // The next row streams in while this one is labelled: the transpose
+    // is otherwise bound by load latency, not bandwidth (measured).
+    const char* next = reinterpret_cast<const char*>(&cloud.points[std::size_t{r + 1} * w]);
+    for (std::size_t b = 0; b < std::size_t{w} * sizeof(Eigen::Vector3f); b += 64)
+      __builtin_prefetch(next + b);
+  }
+  const bool above = r > 0;
+  if (link_row::ComputeMasks(cur, above ? &up : nullptr, eight, g.words, r2, g.m()))
+    return absl::InvalidArgumentError(
+        absl::StrCat("link clustering: row ", r, " holds an infinite coordinate"));
+  const RowMasks m = g.m();
+  const uint64_t* const vertical[3] = {m.north_west, m.north, m.north_east};
+  const bool merge = above && r > band_first;
+  if (above && !merge)
+    for (int k = 0; k < 3; ++k) std::copy(vertical[k], vertical[k] + g.words, &seam[k * g.words]);
+  link_row::RunBounds(m, g.words, g.starts(), g.ends());
+  const uint64_t* starts = g.starts();
+  const uint64_t* ends = g.ends();
+  std::vector<int32_t>& run_here = g.run_of[r & 1];
+  const std::vector<int32_t>& run_above = g.run_of[(r + 1) & 1];
+  for (uint32_t s = NextBit(starts, g.words, 0); s != kNone; s = NextBit(starts, g.words, s + 1)) {
+    const uint32_t e = NextBit(ends, g.words, s);
+    const int32_t id = g.forest.Add();
+    g.runs.push_back({r, s, e, {0, 0, 0}, {0, 0, 0}});
+    link_row::Bounds(cur, s, e, g.runs.back().lo, g.runs.back().hi);
+    std::fill(run_here.begin() + s, run_here.begin() + e + 1, id);
+    if (merge)
+      MergeWithRunsAbove(vertical, id, s, e, w, eight, run_above.data(), g.runs.data(), 0,
+                         g.forest);
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+void LabelBand(const PointCloud& cloud, float r2, bool eight, const std::atomic<bool>* cancel,
+               Band& band) {
+  GridScratch g(cloud.width, band.end - band.first);
+  band.seam.assign(3 * std::size_t{g.words}, 0);
+  // The row above the band, for the first row's vertical masks.
+  if (band.first > 0)
+    link_row::Transpose(&cloud.points[std::size_t{band.first - 1} * cloud.width], cloud.width,
+                        g.rows[(band.first - 1) & 1]);
+  for (uint32_t r = band.first; r < band.end; ++r) {
+    if (IsCancelled(cancel)) {
+      band.status = absl::CancelledError("link clustering: cancelled");
+      return;
+    }
+    band.status = LabelRow(cloud, r, band.first, r2, eight, g, band.seam);
+    if (!band.status.ok()) return;
+    if (r == band.first) band.first_row_runs = g.runs.size();
+  }
+  band.runs = std::move(g.runs);
+  band.forest = std::move(g.forest);
+  band.last_row_runs = std::move(g.run_of[(band.end - 1) & 1]);
+}
+
+UnionFind JoinBands(std::vector<Band>& bands, uint32_t width, bool eight) {
+  const uint32_t words = (width + 63) / 64;
+  UnionFind forest;
+  for (std::size_t b = 0; b < bands.size(); ++b) {
+    Band& band = bands[b];
+    band.offset = forest.size();
+    forest.Append(band.forest);
+    if (b == 0) continue;
+    const uint64_t* const vertical[3] = {&band.seam[0], &band.seam[words],
+                                         &band.seam[2 * std::size_t{words}]};
+    const Band& above = bands[b - 1];
+    for (std::size_t i = 0; i < band.first_row_runs; ++i)
+      MergeWithRunsAbove(vertical, static_cast<int32_t>(band.offset + i), band.runs[i].first_col,
+                         band.runs[i].last_col, width, eight, above.last_row_runs.data(),
+                         above.runs.data(), static_cast<int32_t>(above.offset), forest);
+  }
+  return forest;
+}
+
+}  // namespace surfinspect::grid
