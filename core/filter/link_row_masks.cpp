@@ -76,10 +76,12 @@ bool RowBits(const RowSoA& cur, const RowSoA& up, uint32_t words, float r2, cons
       const __m128 px = _mm_loadu_ps(x + i), py = _mm_loadu_ps(y + i), pz = _mm_loadu_ps(z + i);
       const __m128 s =
           _mm_add_ps(_mm_add_ps(_mm_mul_ps(px, zero), _mm_mul_ps(py, zero)), _mm_mul_ps(pz, zero));
-      valid |= uint64_t(_mm_movemask_ps(_mm_cmpeq_ps(s, zero))) << j;
+      const uint64_t valid4 = uint64_t(_mm_movemask_ps(_mm_cmpeq_ps(s, zero)));
+      valid |= valid4 << j;
       any_inf = _mm_or_ps(any_inf, _mm_or_ps(_mm_cmpeq_ps(_mm_and_ps(px, abs_mask), inf),
                                              _mm_cmpeq_ps(_mm_and_ps(py, abs_mask), inf)));
       any_inf = _mm_or_ps(any_inf, _mm_cmpeq_ps(_mm_and_ps(pz, abs_mask), inf));
+      if (valid4 == 0) continue;  // no data links to nothing (as in the AVX2 pass)
       west |= Link4(px, py, pz, x + i - 1, y + i - 1, z + i - 1, r) << j;
       if (kAbove) north |= Link4(px, py, pz, ux + i, uy + i, uz + i, r) << j;
       if (kDiagonals) {

@@ -35,11 +35,16 @@ bool Pass(const float* const cur[3], const float* const up[3], uint32_t words, f
       // 0 * NaN and 0 * inf are NaN: the sum is 0 only for a valid pixel.
       const __m256 s = _mm256_add_ps(
           _mm256_add_ps(_mm256_mul_ps(px, zero), _mm256_mul_ps(py, zero)), _mm256_mul_ps(pz, zero));
-      valid |= uint64_t(_mm256_movemask_ps(_mm256_cmp_ps(s, zero, _CMP_EQ_OQ))) << j;
+      const uint64_t valid8 = uint64_t(_mm256_movemask_ps(_mm256_cmp_ps(s, zero, _CMP_EQ_OQ)));
+      valid |= valid8 << j;
       any_inf = _mm256_or_ps(
           any_inf, _mm256_or_ps(_mm256_cmp_ps(_mm256_and_ps(px, abs_mask), inf, _CMP_EQ_OQ),
                                 _mm256_cmp_ps(_mm256_and_ps(py, abs_mask), inf, _CMP_EQ_OQ)));
       any_inf = _mm256_or_ps(any_inf, _mm256_cmp_ps(_mm256_and_ps(pz, abs_mask), inf, _CMP_EQ_OQ));
+      // A pixel without data links to nothing: eight of them in a row (a
+      // shadow, the background) skip the link tests, which are the pass's
+      // float work.
+      if (valid8 == 0) continue;
       west |= Link8(px, py, pz, x + i - 1, y + i - 1, z + i - 1, r) << j;
       if (kAbove) north |= Link8(px, py, pz, ux + i, uy + i, uz + i, r) << j;
       if (kDiagonals) {
