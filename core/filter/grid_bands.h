@@ -39,11 +39,15 @@ struct Band {
   std::size_t first_row_runs = 0;
   std::size_t offset = 0;  // of its first run among all, set by the join
   absl::Status status;
-  // Set by the numbering pass (link_clustering_grid.cpp): its components'
-  // count and first id, and its runs (band-local indices) whose component
-  // starts in an earlier band.
-  std::size_t roots = 0, first_id = 0;
-  std::vector<uint32_t> foreign;
+  // Set by the numbering pass (link_clustering_grid.cpp): its first
+  // component id, and its runs (band-local index, root) whose component
+  // begins in an earlier band.
+  std::size_t first_id = 0;
+  struct Foreign {
+    uint32_t run;
+    int32_t root;
+  };
+  std::vector<Foreign> foreign;
 };
 
 // Labels rows [band.first, band.end) of `cloud` with squared link distance

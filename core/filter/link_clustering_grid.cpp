@@ -43,62 +43,51 @@ void Fold(const Run& run, bool first, ClusterInfo& k) {
   k.max = k.max.cwiseMax(run.max());
 }
 
-// Pass 2a, one band: its roots (parent[i] == i: a component's first run)
-// numbered in raster order within the band.
-void NumberRoots(Band& band, const std::vector<int32_t>& parent, std::vector<int32_t>& local_id) {
-  band.roots = 0;
-  for (std::size_t i = band.offset; i < band.offset + band.runs.size(); ++i)
-    if (parent[i] == static_cast<int32_t>(i)) local_id[i] = static_cast<int32_t>(band.roots++);
-}
-
-// Pass 2b, one band: each run's component id (ids in raster order of each
-// component's first run) and the statistics of the components that start
-// in this band. A run whose component starts in an earlier band is kept in
-// band.foreign, folded afterwards in band order: every component is then
-// folded in raster order, as by one serial pass, and no two threads write
-// the same component.
-void NumberRuns(Band& band, const std::vector<Band>& bands, const std::vector<int32_t>& parent,
-                const std::vector<int32_t>& local_id, std::vector<int32_t>& component,
+// Pass 2, one band: each run's component id and the statistics of the
+// components that begin in this band. Ids are in raster order of each
+// component's first run, its root (parent[i] == i), and the band's ids
+// begin at band.first_id. A run whose component begins in an earlier band
+// goes to band.foreign with its root, for NumberComponents to fold
+// afterwards in band order: every component then folds in raster order, as
+// in one serial pass, and no two threads write the same component.
+void NumberRuns(Band& band, const std::vector<int32_t>& parent, std::vector<int32_t>& component,
                 std::vector<ClusterInfo>& clusters) {
   band.foreign.clear();
+  auto next = static_cast<int32_t>(band.first_id);
   for (std::size_t j = 0; j < band.runs.size(); ++j) {
     const std::size_t i = band.offset + j;
     int32_t root = parent[i];
     while (parent[static_cast<std::size_t>(root)] != root) root = parent[root];
     const auto r = static_cast<std::size_t>(root);
-    const bool here = r >= band.offset;
-    const Band& owner =
-        here ? band
-             : *(std::upper_bound(bands.begin(), bands.end(), r,
-                                  [](std::size_t run, const Band& b) { return run < b.offset; }) -
-                 1);
-    const int32_t id = static_cast<int32_t>(owner.first_id) + local_id[r];
+    if (r < band.offset) {
+      band.foreign.push_back({static_cast<uint32_t>(j), root});
+      continue;
+    }
+    // The root comes first in the band: its id is set when a later run asks.
+    const int32_t id = r == i ? next++ : component[r];
     component[i] = id;
-    if (here)
-      Fold(band.runs[j], r == i, clusters[static_cast<std::size_t>(id)]);
-    else
-      band.foreign.push_back(static_cast<uint32_t>(j));
+    Fold(band.runs[j], r == i, clusters[static_cast<std::size_t>(id)]);
   }
 }
 
-// Pass 2: numbers the components and folds their statistics (2a, 2b, then
-// the foreign runs of each band in band order). Returns each run's id.
+// Pass 2: numbers the components and folds their statistics. Returns each
+// run's component id.
 std::vector<int32_t> NumberComponents(std::vector<Band>& bands, const std::vector<int32_t>& parent,
                                       const EachBand& each_band, LinkClusteringResult& result) {
-  std::vector<int32_t> local_id(parent.size()), component(parent.size());
-  each_band([&](Band& band) { NumberRoots(band, parent, local_id); });
   std::size_t total = 0;
   for (Band& band : bands) {
     band.first_id = total;
-    total += band.roots;
+    for (std::size_t i = band.offset; i < band.offset + band.runs.size(); ++i)
+      total += parent[i] == static_cast<int32_t>(i);
   }
+  std::vector<int32_t> component(parent.size());
   result.clusters.resize(total);
-  each_band(
-      [&](Band& band) { NumberRuns(band, bands, parent, local_id, component, result.clusters); });
+  each_band([&](Band& band) { NumberRuns(band, parent, component, result.clusters); });
   for (const Band& band : bands)
-    for (uint32_t j : band.foreign) {
-      const auto id = static_cast<std::size_t>(component[band.offset + j]);
-      Fold(band.runs[j], false, result.clusters[id]);
+    for (const auto& [j, root] : band.foreign) {
+      const int32_t id = component[static_cast<std::size_t>(root)];
+      component[band.offset + j] = id;
+      Fold(band.runs[j], false, result.clusters[static_cast<std::size_t>(id)]);
     }
   return component;
 }
