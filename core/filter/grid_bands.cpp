@@ -17,15 +17,14 @@ using link_row::NextBitUpTo;
 using link_row::RowMasks;
 using link_row::RowSoA;
 
-// Pass-1 state: two rows of structure-of-arrays and of run ids (this row
-// and the one above), the link masks of the current row, and the runs with
-// their union-find.
+// Pass-1 state: two rows of structure-of-arrays (this row and the one
+// above), the link masks of the current row, and the runs with their
+// union-find.
 struct GridScratch {
   GridScratch(uint32_t width, uint32_t height)
       : words((width + 63) / 64),
         rows{RowSoA(64 * words), RowSoA(64 * words)},
-        masks(7 * std::size_t{words}),
-        run_of{std::vector<int32_t>(width), std::vector<int32_t>(width)} {
+        masks(7 * std::size_t{words}) {
     // The demo scan has about 30 runs a row; the reserve avoids regrowing.
     runs.reserve(32 * std::size_t{height});
     forest.Reserve(32 * std::size_t{height});
@@ -40,18 +39,35 @@ struct GridScratch {
   }
   uint64_t* starts() { return masks.data() + 5 * words; }
   uint64_t* ends() { return masks.data() + 6 * words; }
-  std::vector<int32_t> run_of[2];
   std::vector<Run> runs;
-  UnionFind forest;  // over run indices
+  std::size_t row_first = 0;  // index of the current row's first run
+  UnionFind forest;           // over run indices
+};
+
+// The runs of the row above, runs[first..] in column order, walked left to
+// right: the columns asked for along one link direction never decrease in
+// a row, so each direction keeps a cursor and a row's lookups cost one pass
+// over the runs above (no per-column table to fill). `offset` turns an
+// index into runs into the forest's.
+struct RowAbove {
+  const std::vector<Run>& runs;
+  std::size_t cursor[3];
+  int32_t offset;
+  RowAbove(const std::vector<Run>& r, std::size_t first, int32_t off)
+      : runs(r), cursor{first, first, first}, offset(off) {}
+  // The run holding column `col`, which must be valid, along direction k.
+  std::size_t RunAt(int k, uint32_t col) {
+    std::size_t& at = cursor[k];
+    while (runs[at].last_col < col) ++at;
+    return at;
+  }
 };
 
 // Merges run `id` (columns s..e of its row) with every run above that one
 // of its pixels links to along the row's north-west, north and north-east
-// masks. run_above[c] is the run of column c in the row above, an index
-// into `above` and, plus `offset`, into the forest.
+// masks.
 void MergeWithRunsAbove(const uint64_t* const vertical[3], int32_t id, uint32_t s, uint32_t e,
-                        uint32_t width, bool eight, const int32_t* run_above, const Run* above,
-                        int32_t offset, UnionFind& forest) {
+                        uint32_t width, bool eight, RowAbove& above, UnionFind& forest) {
   // Most runs are a single outlier pixel, linked to nothing above: one test.
   if (s / 64 == e / 64) {
     const uint32_t k = s / 64;
@@ -67,9 +83,9 @@ void MergeWithRunsAbove(const uint64_t* const vertical[3], int32_t id, uint32_t 
     // reach that same run: merge once, then skip past it.
     for (uint32_t c = NextBitUpTo(vertical[k], s, e); c != kNone;
          c = NextBitUpTo(vertical[k], c, e)) {
-      const int32_t run_up = run_above[c + offsets[k]];
-      forest.Union(id, run_up + offset);
-      const int64_t past = int64_t{above[run_up].last_col} - offsets[k] + 1;
+      const std::size_t run_up = above.RunAt(k, c + offsets[k]);
+      forest.Union(id, static_cast<int32_t>(run_up) + above.offset);
+      const int64_t past = int64_t{above.runs[run_up].last_col} - offsets[k] + 1;
       c = static_cast<uint32_t>(std::max<int64_t>(c + 1, past));
       if (c >= width) break;
     }
@@ -105,17 +121,14 @@ absl::Status LabelRow(const PointCloud& cloud, uint32_t r, uint32_t band_first, 
   link_row::RunBounds(m, g.words, g.starts(), g.ends());
   const uint64_t* starts = g.starts();
   const uint64_t* ends = g.ends();
-  std::vector<int32_t>& run_here = g.run_of[r & 1];
-  const std::vector<int32_t>& run_above = g.run_of[(r + 1) & 1];
+  RowAbove row_above(g.runs, g.row_first, 0);
+  g.row_first = g.runs.size();
   for (uint32_t s = NextBit(starts, g.words, 0); s != kNone; s = NextBit(starts, g.words, s + 1)) {
     const uint32_t e = NextBit(ends, g.words, s);
     const int32_t id = g.forest.Add();
     g.runs.push_back({r, s, e, {0, 0, 0}, {0, 0, 0}});
     link_row::Bounds(cur, s, e, g.runs.back().lo, g.runs.back().hi);
-    std::fill(run_here.begin() + s, run_here.begin() + e + 1, id);
-    if (merge)
-      MergeWithRunsAbove(vertical, id, s, e, w, eight, run_above.data(), g.runs.data(), 0,
-                         g.forest);
+    if (merge) MergeWithRunsAbove(vertical, id, s, e, w, eight, row_above, g.forest);
   }
   return absl::OkStatus();
 }
@@ -141,7 +154,7 @@ void LabelBand(const PointCloud& cloud, float r2, bool eight, const std::atomic<
   }
   band.runs = std::move(g.runs);
   band.forest = std::move(g.forest);
-  band.last_row_runs = std::move(g.run_of[(band.end - 1) & 1]);
+  band.last_row_first = g.row_first;
 }
 
 UnionFind JoinBands(std::vector<Band>& bands, uint32_t width, bool eight) {
@@ -155,10 +168,10 @@ UnionFind JoinBands(std::vector<Band>& bands, uint32_t width, bool eight) {
     const uint64_t* const vertical[3] = {&band.seam[0], &band.seam[words],
                                          &band.seam[2 * std::size_t{words}]};
     const Band& above = bands[b - 1];
+    RowAbove row_above(above.runs, above.last_row_first, static_cast<int32_t>(above.offset));
     for (std::size_t i = 0; i < band.first_row_runs; ++i)
       MergeWithRunsAbove(vertical, static_cast<int32_t>(band.offset + i), band.runs[i].first_col,
-                         band.runs[i].last_col, width, eight, above.last_row_runs.data(),
-                         above.runs.data(), static_cast<int32_t>(above.offset), forest);
+                         band.runs[i].last_col, width, eight, row_above, forest);
   }
   return forest;
 }

@@ -28,13 +28,13 @@ struct Run {
 };
 
 // Rows [first, end) labelled apart from the others: their runs, the
-// union-find over them (band-local indices), the run of each column in the
-// last row, and the first row's vertical masks and run count for the join.
+// union-find over them (band-local indices), where the last row's runs
+// begin, and the first row's vertical masks and run count for the join.
 struct Band {
   uint32_t first = 0, end = 0;
   std::vector<Run> runs;
   UnionFind forest;
-  std::vector<int32_t> last_row_runs;
+  std::size_t last_row_first = 0;  // index of the last row's first run
   std::vector<uint64_t> seam;
   std::size_t first_row_runs = 0;
   std::size_t offset = 0;  // of its first run among all, set by the join
