@@ -153,6 +153,12 @@ TEST(LinkRowRuns, StartsEndsAndNextBitMatchTheirDefinitions) {
       ASSERT_EQ(NextBit(starts.data(), words, i), want) << i;
     }
     EXPECT_EQ(NextBit(starts.data(), words, n), kNone);
+    // The bounded scan: the first set bit in [from, last] or none.
+    for (uint32_t from = 0; from < n; from += 3)
+      for (uint32_t last = from; last < n; last += 17) {
+        const uint32_t next = NextBit(starts.data(), words, from);
+        ASSERT_EQ(NextBitUpTo(starts.data(), from, last), next <= last ? next : kNone);
+      }
   }
 }
 
