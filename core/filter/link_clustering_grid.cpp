@@ -63,7 +63,8 @@ void NumberRuns(Band& band, const std::vector<int32_t>& parent, std::vector<int3
       band.foreign.push_back({static_cast<uint32_t>(j), root});
       continue;
     }
-    // The root comes first in the band: its id is set when a later run asks.
+    // The root is its component's first run: its id is set before any other
+    // run of the component asks for it.
     const int32_t id = r == i ? next++ : component[r];
     component[i] = id;
     Fold(band.runs[j], r == i, clusters[static_cast<std::size_t>(id)]);
