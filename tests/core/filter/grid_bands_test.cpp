@@ -6,49 +6,20 @@
 #include <random>
 
 #include "core/filter/link_clustering.h"
+#include "tests/support/link_grids.h"
 
 namespace surfinspect::grid {
 namespace {
 
-// Rows of 0.3 mm pitch with random heights (about half the links hold) and
-// NaN holes.
-PointCloud Grid(std::mt19937& rng, uint32_t w, uint32_t h) {
-  PointCloud c = PointCloud::Organized(w, h);
-  std::uniform_real_distribution<float> u(0.f, 1.f);
-  for (uint32_t r = 0; r < h; ++r)
-    for (uint32_t col = 0; col < w; ++col)
-      c.points[r * w + col] = u(rng) < 0.15f ? Eigen::Vector3f(NAN, NAN, NAN)
-                                             : Eigen::Vector3f(0.3f * col, 0.3f * r, 0.6f * u(rng));
-  return c;
-}
-
-// The textbook oracle: union-find over pixels, one union per linked pair
-// of grid neighbours.
-std::vector<int32_t> PixelRoots(const PointCloud& c, bool eight, float r2) {
-  UnionFind uf(c.size());
-  const int w = static_cast<int>(c.width), h = static_cast<int>(c.height);
-  for (int r = 0; r < h; ++r)
-    for (int col = 0; col < w; ++col)
-      for (int dr = -1; dr <= 1; ++dr)
-        for (int dc = -1; dc <= 1; ++dc) {
-          const int rr = r + dr, cc = col + dc;
-          if ((dr == 0 && dc == 0) || (!eight && dr != 0 && dc != 0)) continue;
-          if (rr < 0 || rr >= h || cc < 0 || cc >= w) continue;
-          if (PointsLinked(c.points[r * w + col], c.points[rr * w + cc], r2))
-            uf.Union(r * w + col, rr * w + cc);
-        }
-  std::vector<int32_t> roots(c.size());
-  for (std::size_t i = 0; i < c.size(); ++i) roots[i] = uf.Find(static_cast<int32_t>(i));
-  return roots;
-}
-
+// The bands' runs and forest against the grid path's brute-force oracle
+// (tests/support/link_grids.h), on grids of one to four bands.
 TEST(GridBands, JoinedBandsGiveThePixelGraphsComponentsWithTheLowestRunAsRoot) {
   std::mt19937 rng(5);
   std::uniform_int_distribution<uint32_t> width(1, 80), height(1, 3 * kBandRows + 20);
   const float r2 = LinkDistanceSquared(0.5);
   for (int trial = 0; trial < 30; ++trial) {
     const uint32_t w = width(rng), h = height(rng);
-    const PointCloud c = Grid(rng, w, h);
+    const PointCloud c = testing::RandomGrid(rng, w, h, 0.15);
     const bool eight = trial % 2 == 0;
     std::vector<Band> bands((h + kBandRows - 1) / kBandRows);
     for (std::size_t b = 0; b < bands.size(); ++b) {
@@ -58,7 +29,7 @@ TEST(GridBands, JoinedBandsGiveThePixelGraphsComponentsWithTheLowestRunAsRoot) {
       ASSERT_TRUE(bands[b].status.ok()) << bands[b].status;
     }
     UnionFind forest = JoinBands(bands, w, eight);
-    SCOPED_TRACE(testing::Message() << "trial " << trial << " " << w << "x" << h);
+    SCOPED_TRACE(::testing::Message() << "trial " << trial << " " << w << "x" << h);
     // The runs tile the valid pixels, each a maximal west-linked chain.
     std::vector<int32_t> run_of(c.size(), -1);
     for (const Band& band : bands)
@@ -80,12 +51,12 @@ TEST(GridBands, JoinedBandsGiveThePixelGraphsComponentsWithTheLowestRunAsRoot) {
         EXPECT_FALSE(run.last_col + 1 < w && PointsLinked(c.points[row + run.last_col],
                                                           c.points[row + run.last_col + 1], r2));
       }
-    const std::vector<int32_t> oracle = PixelRoots(c, eight, r2);
+    const std::vector<int32_t> oracle = testing::GridOracle(c, eight ? 8 : 4, r2);
     // Same partition, and every root is its component's lowest run (the
     // raster numbering of pass 2 relies on it).
     std::vector<int32_t> lowest_run(c.size(), INT32_MAX);
     for (std::size_t p = 0; p < c.size(); ++p) {
-      ASSERT_EQ(run_of[p] >= 0, std::isfinite(c.points[p].x()));
+      ASSERT_EQ(run_of[p] >= 0, PointCloud::IsValid(c.points[p]));
       if (run_of[p] < 0) continue;
       int32_t& low = lowest_run[static_cast<std::size_t>(oracle[p])];
       low = std::min(low, run_of[p]);

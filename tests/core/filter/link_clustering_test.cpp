@@ -14,49 +14,20 @@
 
 #include "core/filter/link_clustering_grid.h"
 #include "core/filter/link_clustering_unorganized.h"
+#include "tests/support/link_grids.h"
 
 namespace surfinspect {
 namespace {
 
 constexpr int32_t kInvalid = LinkClusteringResult::kInvalid;
+using testing::GridOracle;
+using testing::RandomGrid;
 
 // The random inputs below are scaled for a 0.5 mm link distance.
 LinkClusteringSettings HalfMm() {
   LinkClusteringSettings s;
   s.link_distance_mm = 0.5;
   return s;
-}
-
-// Brute-force oracle for the grid: BFS from every unvisited valid pixel over
-// the 4 or 8 grid neighbours, linking with the same predicate.
-std::vector<int32_t> GridOracle(const PointCloud& c, int connectivity, float r2) {
-  const int w = static_cast<int>(c.width), h = static_cast<int>(c.height);
-  std::vector<int32_t> label(c.size(), kInvalid);
-  int32_t next = 0;
-  for (int start = 0; start < w * h; ++start) {
-    if (!PointCloud::IsValid(c.points[start]) || label[start] != kInvalid) continue;
-    std::queue<int> q;
-    q.push(start);
-    label[start] = next;
-    while (!q.empty()) {
-      const int i = q.front();
-      q.pop();
-      const int r = i / w, col = i % w;
-      for (int dr = -1; dr <= 1; ++dr)
-        for (int dc = -1; dc <= 1; ++dc) {
-          if ((dr == 0 && dc == 0) || (connectivity == 4 && dr != 0 && dc != 0)) continue;
-          const int rr = r + dr, cc = col + dc;
-          if (rr < 0 || rr >= h || cc < 0 || cc >= w) continue;
-          const int j = rr * w + cc;
-          if (label[j] != kInvalid || !PointCloud::IsValid(c.points[j])) continue;
-          if (!PointsLinked(c.points[i], c.points[j], r2)) continue;
-          label[j] = next;
-          q.push(j);
-        }
-    }
-    ++next;
-  }
-  return label;
 }
 
 // O(n^2) oracle for unorganized clouds: every pair is tested.
@@ -155,27 +126,6 @@ void ExpectConsistent(const PointCloud& c, const LinkClusteringResult& r,
   }
 }
 
-// A grid at 0.3 mm pitch whose heights jump randomly, so that roughly half
-// the straight and fewer of the diagonal links hold, with NaN holes.
-PointCloud RandomGrid(std::mt19937& rng, uint32_t w, uint32_t h, double hole_fraction) {
-  PointCloud c = PointCloud::Organized(w, h);
-  std::uniform_real_distribution<float> u(0.f, 1.f);
-  for (uint32_t r = 0; r < h; ++r)
-    for (uint32_t col = 0; col < w; ++col) {
-      if (u(rng) < hole_fraction) {
-        // No data comes in several spellings; all must count as no data.
-        const float nan = NAN;
-        const int kind = static_cast<int>(u(rng) * 3);
-        c.points[r * w + col] = kind == 0   ? Eigen::Vector3f(nan, nan, nan)
-                                : kind == 1 ? Eigen::Vector3f(0.3f * col, nan, 1.f)
-                                            : Eigen::Vector3f(0.3f * col, 0.3f * r, -nan);
-        continue;
-      }
-      c.points[r * w + col] = {0.3f * col, 0.3f * r, 0.6f * u(rng)};
-    }
-  return c;
-}
-
 TEST(LinkClusteringGrid, MatchesBfsOracleOnRandomGrids) {
   std::mt19937 rng(11);
   std::uniform_int_distribution<uint32_t> size(2, 40);
@@ -190,7 +140,7 @@ TEST(LinkClusteringGrid, MatchesBfsOracleOnRandomGrids) {
       auto r = ClusterLinks(c, s);
       ASSERT_TRUE(r.ok()) << r.status();
       EXPECT_TRUE(r->organized_path);
-      SCOPED_TRACE(testing::Message()
+      SCOPED_TRACE(::testing::Message()
                    << "trial " << trial << " " << w << "x" << h << " conn " << conn);
       ExpectSamePartition(r->labels, GridOracle(c, conn, LinkDistanceSquared(0.5)));
       ExpectConsistent(c, *r, s);
@@ -220,7 +170,7 @@ TEST(LinkClusteringGrid, WideGridsCrossMaskWords) {
       s.min_cluster_points = 3;
       auto r = ClusterLinks(c, s);
       ASSERT_TRUE(r.ok());
-      SCOPED_TRACE(testing::Message() << "trial " << trial << " " << w << "x" << h);
+      SCOPED_TRACE(::testing::Message() << "trial " << trial << " " << w << "x" << h);
       ExpectSamePartition(r->labels, GridOracle(c, conn, LinkDistanceSquared(0.5)));
       ExpectConsistent(c, *r, s);
       if (HasFatalFailure()) return;
@@ -276,7 +226,7 @@ TEST(LinkClusteringGrid, TallGridsJoinTheirBandsAtTheSeams) {
       s.min_cluster_points = 1 + trial % 5;
       auto r = ClusterLinks(c, s);
       ASSERT_TRUE(r.ok()) << r.status();
-      SCOPED_TRACE(testing::Message()
+      SCOPED_TRACE(::testing::Message()
                    << "trial " << trial << " " << w << "x" << h << " conn " << conn);
       ExpectSamePartition(r->labels, GridOracle(c, conn, LinkDistanceSquared(0.5)));
       ExpectRasterNumbering(r->labels);
@@ -330,7 +280,7 @@ TEST(LinkClusteringUnorganized, MatchesPairwiseOracle) {
     auto r = ClusterLinks(c, s);
     ASSERT_TRUE(r.ok()) << r.status();
     EXPECT_FALSE(r->organized_path);
-    SCOPED_TRACE(testing::Message() << "trial " << trial << " n " << c.size());
+    SCOPED_TRACE(::testing::Message() << "trial " << trial << " n " << c.size());
     ExpectSamePartition(r->labels, PairOracle(c, LinkDistanceSquared(s.link_distance_mm)));
     ExpectConsistent(c, *r, s);
     if (HasFatalFailure()) return;
