@@ -53,25 +53,14 @@ bool ComputeMasks(const RowSoA& cur, const RowSoA* up, bool diagonals, uint32_t 
 // west-linked) of a row, from its valid and west masks.
 void RunBounds(const RowMasks& m, uint32_t words, uint64_t* starts, uint64_t* ends);
 
-// The first set bit at index >= from in `words` mask words, or kNone.
+// "No set bit" for the bit scans below.
 constexpr uint32_t kNone = UINT32_MAX;
-inline uint32_t NextBit(const uint64_t* bits, uint32_t words, uint32_t from) {
-  uint32_t k = from / 64;
-  if (k >= words) return kNone;
-  uint64_t w = bits[k] & (~uint64_t{0} << (from % 64));
-  while (w == 0) {
-    if (++k == words) return kNone;
-    w = bits[k];
-  }
-  return 64 * k + static_cast<uint32_t>(__builtin_ctzll(w));
-}
-
-// The first set bit at index in [from, last], or kNone. Unlike NextBit it
-// reads no word past last's: a run's vertical links end at the run.
+// The first set bit at index in [from, last], or kNone. It reads no word
+// past last's: a run's vertical links end at the run.
 inline uint32_t NextBitUpTo(const uint64_t* bits, uint32_t from, uint32_t last) {
+  if (from > last) return kNone;
   uint32_t k = from / 64;
   const uint32_t k_last = last / 64;
-  if (from > last) return kNone;
   uint64_t w = bits[k] & (~uint64_t{0} << (from % 64));
   while (w == 0) {
     if (++k > k_last) return kNone;
@@ -79,6 +68,11 @@ inline uint32_t NextBitUpTo(const uint64_t* bits, uint32_t from, uint32_t last) 
   }
   const uint32_t c = 64 * k + static_cast<uint32_t>(__builtin_ctzll(w));
   return c <= last ? c : kNone;
+}
+
+// The first set bit at index >= from in `words` mask words, or kNone.
+inline uint32_t NextBit(const uint64_t* bits, uint32_t words, uint32_t from) {
+  return words == 0 ? kNone : NextBitUpTo(bits, from, 64 * words - 1);
 }
 
 // Bounds of the pixels first..last of the row, which must all be valid.
