@@ -44,6 +44,18 @@ def cloud(w, h, raw=None):
     return f"{{ xyz: {esc(raw)} width: {w} height: {h} }}"
 
 
+def packed_cloud(w, h):
+    """cloud_bytes' grid without its no-data point (index 1), by valid_bits."""
+    raw = cloud_bytes(w, h)
+    bits = bytearray((w * h + 7) // 8)
+    kept = b""
+    for i in range(w * h):
+        if i != 1:
+            bits[i // 8] |= 1 << (i % 8)
+            kept += raw[12 * i:12 * i + 12]
+    return f"{{ xyz: {esc(kept)} width: {w} height: {h} valid_bits: {esc(bytes(bits))} }}"
+
+
 MESH = ("{ inline { vertices: " + esc(floats([0, 0, 0, 100, 0, 0, 0, 100, 0])) +
         " triangles: " + esc(struct.pack("<3I", 0, 1, 2)) + " } }")
 FILTER = "{ link_distance_mm: 0.5 min_cluster_points: 4 connectivity: 8 min_fraction_of_largest: 0.1 }"
@@ -56,6 +68,7 @@ SEEDS = {
         "valid": ("FilterRequest", f"cloud: {cloud(3, 2)} settings: {FILTER}"),
         "defaults": ("FilterRequest", f"cloud: {cloud(4, 1)}"),
         "short-bytes": ("FilterRequest", f"cloud: {{ xyz: {esc(b'abc')} width: 2 height: 2 }}"),
+        "packed": ("FilterRequest", f"cloud: {packed_cloud(5, 3)} settings: {FILTER}"),
         "bad-settings": ("FilterRequest", f"cloud: {cloud(2, 1)} settings: {{ connectivity: 5 }}"),
     },
     "calibrate_request": {
@@ -84,6 +97,8 @@ SEEDS = {
                   f"world_from_part: {transform()} settings: {ERRMAP} return_deviations: true"),
         "defaults": ("ErrorMapRequest", f"cloud: {cloud(2, 2)} part {{ sha256: \"abc\" }} "
                      f"world_from_part: {transform()}"),
+        "packed": ("ErrorMapRequest", f"cloud: {packed_cloud(3, 3)} part: {MESH} "
+                   f"world_from_part: {transform()} return_deviations: true"),
         "even-bins": ("ErrorMapRequest", f"cloud: {cloud(1, 1)} part: {MESH} "
                       f"world_from_part: {transform()} settings {{ histogram_bins: 40 }}"),
     },

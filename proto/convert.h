@@ -29,8 +29,11 @@ struct Limits {
 };
 
 // ---- clouds ----
+// Either spelling of a cloud: the whole grid, or packed (valid_bits set;
+// proto/packed_cloud.h).
 absl::StatusOr<PointCloud> CloudFromProto(const v1::PointCloud& msg, const std::string& field,
                                           const Limits& limits);
+// The whole grid, as responses send it; requests use CloudToRequestProto.
 void CloudToProto(const PointCloud& cloud, v1::PointCloud* msg);
 // Validates width/height against limits; the bytes follow separately.
 absl::Status CheckCloudShape(uint64_t width, uint64_t height, const std::string& field,

@@ -1,9 +1,11 @@
 // The scan simulator's ray-cast throughput (no peer: Open3D 0.16's
 // cast_rays returns no hits with Debian's Embree, which has ray masks
 // compiled in) and the service overhead: a 1024x768 scan's ErrorMap
-// in-process and through a surfinspectd child process on loopback (mesh
-// cached there by hash before timing), and one 9.4 MB organized cloud
-// streamed in 1 MB chunks until the server reports it received.
+// in-process (error map, default plan's verdict, report text: the steps of
+// the CLI without --server and of the RPC's handler) and through a
+// surfinspectd child process on loopback (mesh cached there before timing),
+// and one 9.4 MB organized cloud streamed in 1 MB chunks until the server
+// reports it received.
 #pragma once
 
 #include <grpcpp/grpcpp.h>
@@ -17,10 +19,13 @@
 #include "client/remote/remote_client.h"
 #include "core/errormap/error_map.h"
 #include "core/io/mesh_hash.h"
+#include "core/pipeline/inspection.h"
+#include "core/pipeline/plan_evaluation.h"
 #include "core/simulation/demo_cell.h"
 #include "core/simulation/scan_simulator.h"
 #include "core/types/transform.h"
 #include "proto/convert.h"
+#include "proto/packed_cloud.h"
 #include "tests/support/server_process.h"
 
 namespace surfinspect::bench {
@@ -91,11 +96,17 @@ inline void AddServiceRows(std::vector<Row>& rows) {
   }
   const PointCloud cloud = TransformCloud(scan->cloud_in_sensor, vp.world_from_sensor);
   v1::ErrorMapRequest req;
-  wire::CloudToProto(cloud, req.mutable_cloud());
+  wire::CloudToRequestProto(cloud, req.mutable_cloud());
   wire::TransformToProto(cell.world_from_part, req.mutable_world_from_part());
   req.set_return_deviations(true);
 
+  // In-process is what `surfinspect errormap` does without --server, and
+  // what the ErrorMap handler does once the request is decoded: the error
+  // map, then the verdict of the default plan and the report.
+  const ErrorMapSettings settings;
+  const InspectionPlan plan = PlanFromSettings(settings);
   ErrorMapResult local;
+  std::string local_report, local_verdict;
   v1::ErrorMapResponse remote;
   bool remote_ok = true;
   // A client builds its request once and moves it into the call, so each
@@ -106,9 +117,14 @@ inline void AddServiceRows(std::vector<Row>& rows) {
   std::size_t next = 0;
   const auto [t_local, t_remote] = MedianSecondsInterleaved(
       kReps, true,
-      [&] {
+      [&] {  // the handler's steps: error map, plan verdict, report text
         auto r = ComputeErrorMap(**index, cloud, cell.world_from_part, {});
-        if (r.ok()) local = std::move(*r);
+        if (!r.ok()) return;
+        auto outcome = EvaluatePlan(*r, cloud, cell.part, plan, settings.threads);
+        if (!outcome.ok()) return;
+        local_report = ErrorMapReportText(*r, settings, *outcome);
+        local_verdict = outcome->pass() ? "pass" : "fail";
+        local = std::move(*r);
       },
       [&] {  // the warm-up caches the mesh
         if (next == requests.size()) {
@@ -130,14 +146,16 @@ inline void AddServiceRows(std::vector<Row>& rows) {
     if (!(d == l || (std::isnan(d) && std::isnan(l)))) ++differ;
   }
   const double ratio = t_remote / t_local;
-  rows.push_back(
-      {"Service: ErrorMap of a 1024x768 scan, gRPC loopback vs in-process", Time(t_local),
-       remote_ok ? Time(t_remote) + " (via surfinspectd)" : "failed", Fmt("%.2fx", ratio),
-       !sized ? "deviations missing"
-       : differ == 0
-           ? "identical deviations (" + std::to_string(local.deviation_mm.size()) + " points)"
-           : std::to_string(differ) + " deviations differ",
-       "≤ 1.3x in-process", Verdict(remote_ok && ratio <= 1.3)});
+  rows.push_back({"Service: ErrorMap of a 1024x768 scan, gRPC loopback vs in-process",
+                  Time(t_local), remote_ok ? Time(t_remote) + " (via surfinspectd)" : "failed",
+                  Fmt("%.2fx", ratio),
+                  !sized        ? "deviations missing"
+                  : differ != 0 ? std::to_string(differ) + " deviations differ"
+                  : local_verdict != remote.verdict()
+                      ? "verdicts differ"
+                      : "identical deviations (" + std::to_string(local.deviation_mm.size()) +
+                            " points), same verdict",
+                  "≤ 1.3x in-process", Verdict(remote_ok && ratio <= 1.3)});
 
   // Streaming one view.
   auto stub = v1::InspectionService::NewStub(

@@ -4,6 +4,7 @@
 #include "core/io/io_point_cloud.h"
 #include "core/registration/calibration.h"
 #include "proto/convert.h"
+#include "proto/packed_cloud.h"
 
 namespace surfinspect::client {
 namespace {
@@ -23,7 +24,7 @@ ViewCalibration CalibrateView(CellViewpoint& vp, const CalibrateFn& calibrate,
   v1::CalibrateRequest req;
   wire::TransformToProto(vp.world_from_gauge, req.mutable_world_from_gauge());
   wire::TransformToProto(vp.nominal_world_from_sensor, req.mutable_initial_world_from_sensor());
-  wire::CloudToProto(*scan, req.mutable_scan());
+  wire::CloudToRequestProto(*scan, req.mutable_scan());
   wire::IcpSettingsToProto(CalibrationSettings{}.icp, req.mutable_icp());
   absl::StatusOr<v1::CalibrateResponse> resp = absl::CancelledError("stop requested");
   RetryHooks hooks{options.sleep, {}};

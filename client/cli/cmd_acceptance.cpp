@@ -22,6 +22,7 @@
 #include "core/registration/calibration.h"
 #include "core/registration/registration.h"
 #include "proto/convert.h"
+#include "proto/packed_cloud.h"
 
 namespace surfinspect::cli {
 namespace {
@@ -74,7 +75,7 @@ WorldScanFn ScanSource(const AcceptanceArgs& a, const client::CellConfig& cell,
       v1::ViewScan* v = req.add_views();
       v->set_name(view);
       wire::TransformToProto(*vp->world_from_sensor, v->mutable_world_from_sensor());
-      wire::CloudToProto(*cloud, v->mutable_cloud());
+      wire::CloudToRequestProto(*cloud, v->mutable_cloud());
       auto resp = remote->Register(req, nullptr);
       if (!resp.ok()) return resp.status();
       return wire::CloudFromProto(resp->merged(), "merged", wire::Limits{});

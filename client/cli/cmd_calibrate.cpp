@@ -12,6 +12,7 @@
 #include "core/io/io_transform.h"
 #include "core/registration/calibration.h"
 #include "proto/convert.h"
+#include "proto/packed_cloud.h"
 
 namespace surfinspect::cli {
 namespace {
@@ -51,7 +52,7 @@ void Calibrate(const CalibrateArgs& a) {
                          req.mutable_world_from_gauge());
   wire::TransformToProto(Take(ReadTransformJson(a.initial)),
                          req.mutable_initial_world_from_sensor());
-  wire::CloudToProto(Take(ReadPointCloud(a.scan)), req.mutable_scan());
+  wire::CloudToRequestProto(Take(ReadPointCloud(a.scan)), req.mutable_scan());
   wire::IcpSettingsToProto(settings.icp, req.mutable_icp());
   wire::FilterSettingsToProto(settings.filter, req.mutable_filter());
   req.set_skip_filter(a.no_filter);

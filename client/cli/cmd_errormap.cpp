@@ -31,6 +31,7 @@
 #include "core/report/qif_results.h"
 #include "core/types/transform.h"
 #include "proto/convert.h"
+#include "proto/packed_cloud.h"
 
 namespace surfinspect::cli {
 namespace {
@@ -77,7 +78,7 @@ ErrorMapRun RemoteErrorMap(const ErrorMapArgs& a, const PointCloud& cloud_in_wor
   if (a.settings.split_components) throw CommandFailed("--split-components is in-process only");
   if (!a.png.empty() && a.png_axis != "auto") throw CommandFailed("--png-axis is in-process only");
   v1::ErrorMapRequest req;
-  wire::CloudToProto(cloud_in_world, req.mutable_cloud());
+  wire::CloudToRequestProto(cloud_in_world, req.mutable_cloud());
   wire::TransformToProto(world_from_part, req.mutable_world_from_part());
   wire::ErrorMapSettingsToProto(a.settings, req.mutable_settings());
   if (!a.plan.empty()) wire::PlanToProto(plan, req.mutable_plan());

@@ -14,6 +14,7 @@
 #include "core/io/io_point_cloud.h"
 #include "core/io/png_image.h"
 #include "proto/convert.h"
+#include "proto/packed_cloud.h"
 
 namespace surfinspect::cli {
 namespace {
@@ -62,7 +63,7 @@ void Filter(const FilterArgs& a) {
   v1::FilterResponse resp;
   if (a.remote.remote()) {
     v1::FilterRequest req;
-    wire::CloudToProto(cloud, req.mutable_cloud());
+    wire::CloudToRequestProto(cloud, req.mutable_cloud());
     wire::FilterSettingsToProto(a.settings, req.mutable_settings());
     resp = Take(Connect(a.remote)->Filter(req));
   } else {

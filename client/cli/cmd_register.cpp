@@ -8,6 +8,7 @@
 #include "core/io/io_transform.h"
 #include "core/registration/registration.h"
 #include "proto/convert.h"
+#include "proto/packed_cloud.h"
 
 namespace surfinspect::cli {
 namespace {
@@ -28,7 +29,7 @@ void Register(const RegisterArgs& a) {
     v1::ViewScan* v = req.add_views();
     v->set_name("view" + std::to_string(i + 1));
     wire::TransformToProto(Take(ReadTransformJson(a.poses[i])), v->mutable_world_from_sensor());
-    wire::CloudToProto(Take(ReadPointCloud(a.scans[i])), v->mutable_cloud());
+    wire::CloudToRequestProto(Take(ReadPointCloud(a.scans[i])), v->mutable_cloud());
   }
   PointCloud merged;
   if (a.remote.remote()) {
