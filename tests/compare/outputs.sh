@@ -36,4 +36,11 @@ T=$(sed -n 's/^surfinspectd listening on //p' server.out)
 "$BIN/cell-agent" calibrate --cell cell/cell.json --server "$T" >/dev/null
 "$si" inspect --cell cell/cell.json --scans $S --out inspect >/dev/null
 "$si" inspect --cell cell/cell.json --scans $S --out inspect_remote --server "$T" >/dev/null
+# The unary calls through the server (their requests carry packed clouds).
+"$si" filter --in $S/v1.pcd --out filtered_remote.pcd --report filter_remote.json --server "$T" >/dev/null
+"$si" calibrate --gauge cell/gauge.stl --world-from-gauge wfg_v2.json --scan cell/gauge_scans/v2.pcd \
+  --initial-world-from-sensor nominal_v2.json --out cal_remote_v2.json --server "$T" >/dev/null
+"$si" register "${args[@]}" --out merged_remote.ply --filter --server "$T" >/dev/null
+"$si" errormap --cloud $S/v3.pcd --mesh cell/part.stl --out errormap_v3_remote.ply \
+  --csv errormap_v3_remote.csv --max-distance 5 --server "$T" >/dev/null
 rm -f server.out server.log cell/cell.json.bak
