@@ -11,6 +11,7 @@
 // or without the coherent start.
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -44,13 +45,33 @@ uint64_t Spread10(uint64_t v) {
   return v;
 }
 
+// ComputeBounds on the arena's threads. The minimum and maximum of the same
+// points found in another order differ at most in the sign of a zero
+// bound, which the Morton codes below do not see: the extent and every
+// difference p - min keep their values, and a zero of either sign falls in
+// cell 0.
+Bounds3 ParallelBounds(const PointCloud& cloud) {
+  return tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, cloud.size(), kCancelStride), Bounds3{},
+      [&](const tbb::blocked_range<std::size_t>& block, Bounds3 b) {
+        for (std::size_t i = block.begin(); i != block.end(); ++i)
+          if (PointCloud::IsValid(cloud.points[i])) b.Extend(cloud.points[i].cast<double>());
+        return b;
+      },
+      [](Bounds3 a, const Bounds3& b) {
+        a.min = a.min.cwiseMin(b.min);
+        a.max = a.max.cwiseMax(b.max);
+        return a;
+      });
+}
+
 // Visiting order for an unorganized cloud: 30-bit Morton codes on a 1024^3
 // grid over the bounds, sorted by a stable radix sort (equal codes keep
 // input order). Invalid points go last. The codes are computed in parallel
 // blocks (each depends only on its point). The result holds code << 32 |
 // point index, in visiting order; empty if cancelled.
 DefaultInitVector<uint64_t> MortonOrder(const PointCloud& cloud, const std::atomic<bool>* cancel) {
-  const Bounds3 bounds = ComputeBounds(cloud);
+  const Bounds3 bounds = ParallelBounds(cloud);
   const std::size_t n = cloud.size();
   const double extent = bounds.empty() ? 0.0 : (bounds.max - bounds.min).maxCoeff();
   const double scale = extent > 0 ? 1023.0 / extent : 0.0;

@@ -21,7 +21,11 @@ bool RadixSortPairs(std::vector<uint64_t>& keys, std::vector<uint32_t>& values, 
 
 // The same for pairs packed as key << 32 | value (key < 2^key_bits,
 // key_bits <= 32), with 10-bit digits: half the bytes of the unpacked form
-// move per pass, and each pass writes to fewer places at once.
+// move per pass, and each pass writes to fewer places at once. Each pass
+// runs in contiguous chunks on the calling task arena's threads (one chunk
+// per thread, at least 2^16 items each), and a pass whose digit is the same
+// for every item is skipped; the order is the same for any number of
+// threads, as the sort is stable.
 bool RadixSortPacked(DefaultInitVector<uint64_t>& items, int key_bits,
                      const std::atomic<bool>* cancel = nullptr);
 

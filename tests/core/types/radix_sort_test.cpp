@@ -2,6 +2,7 @@
 #include "core/types/radix_sort.h"
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <atomic>
@@ -64,6 +65,31 @@ TEST(RadixSort, PackedMatchesThePairSort) {
       for (std::size_t i = 0; i < n; ++i) {
         ASSERT_EQ(packed[i] >> 32, keys[i]) << key_bits << " bits, item " << i;
         ASSERT_EQ(static_cast<uint32_t>(packed[i]), values[i]) << key_bits << " bits, item " << i;
+      }
+    }
+}
+
+// Chunked passes on 1, 2, 3 and 5 threads give std::stable_sort's order by
+// key, on sizes that split into chunks of unequal length, with a key that
+// leaves some digits the same for every item (a skipped pass) and one that
+// does not.
+TEST(RadixSort, PackedGivesTheStableOrderOnAnyNumberOfThreads) {
+  std::mt19937_64 rng(9);
+  for (std::size_t n : {std::size_t{131072}, std::size_t{700001}})
+    for (const uint64_t key_mask : {uint64_t{0x3fffffff}, uint64_t{0x400003ff}, uint64_t{0x7}}) {
+      DefaultInitVector<uint64_t> input(n);
+      for (std::size_t i = 0; i < n; ++i) input[i] = (rng() & key_mask) << 32 | i;
+      std::vector<uint64_t> want(input.begin(), input.end());
+      std::stable_sort(want.begin(), want.end(),
+                       [](uint64_t a, uint64_t b) { return (a >> 32) < (b >> 32); });
+      for (int threads : {1, 2, 3, 5}) {
+        DefaultInitVector<uint64_t> items = input;
+        bool ok = false;
+        tbb::task_arena(threads).execute([&] { ok = RadixSortPacked(items, 31); });
+        ASSERT_TRUE(ok);
+        ASSERT_TRUE(std::equal(items.begin(), items.end(), want.begin()))
+            << ::testing::Message() << n << " items, key mask " << key_mask << ", " << threads
+            << " threads";
       }
     }
 }
