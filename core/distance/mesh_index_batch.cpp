@@ -36,7 +36,7 @@ constexpr std::size_t kChunk = 256;  // points per chunk: the unit of work and o
 constexpr std::size_t kCertificateProbe = 16;
 
 // Spreads the low 10 bits of v to every third bit (Morton interleave).
-uint64_t Spread10(uint64_t v) {
+constexpr uint32_t Spread10(uint32_t v) {
   v &= 0x3ff;
   v = (v | (v << 16)) & 0x30000ff;
   v = (v | (v << 8)) & 0x300f00f;
@@ -44,6 +44,16 @@ uint64_t Spread10(uint64_t v) {
   v = (v | (v << 2)) & 0x9249249;
   return v;
 }
+
+// Spread10 of every 10-bit value, so a code costs three loads (4 KiB, in
+// the L1 cache) instead of three chains of shifts.
+struct SpreadTable {
+  uint32_t of[1024];
+  constexpr SpreadTable() : of() {
+    for (uint32_t v = 0; v < 1024; ++v) of[v] = Spread10(v);
+  }
+};
+constexpr SpreadTable kSpread;
 
 // ComputeBounds on the arena's threads. The minimum and maximum of the same
 // points found in another order differ at most in the sign of a zero
@@ -91,7 +101,7 @@ DefaultInitVector<uint64_t> MortonOrder(const PointCloud& cloud, const std::atom
             std::array<uint64_t, 3> q;
             for (int a = 0; a < 3; ++a)
               q[a] = static_cast<uint64_t>(std::clamp((p[a] - bounds.min[a]) * scale, 0.0, 1023.0));
-            code = Spread10(q[0]) | (Spread10(q[1]) << 1) | (Spread10(q[2]) << 2);
+            code = kSpread.of[q[0]] | (kSpread.of[q[1]] << 1) | (kSpread.of[q[2]] << 2);
           }
           items[i] = code << 32 | i;
         }

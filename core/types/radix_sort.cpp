@@ -4,6 +4,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <array>
 #include <cstddef>
 #include <utility>
 
@@ -73,8 +74,8 @@ std::size_t PassChunks(std::size_t n) {
 
 // cursor[c * kPackedBuckets + d]: where chunk c writes its first item of
 // digit d, so that the pass is stable (digits in order, and within a digit
-// the chunks in order). False when one digit holds every item: the pass
-// would move nothing.
+// the chunks in order); chunk 0's cursors are where the digits start. False
+// when one digit holds every item: the pass would move nothing.
 bool ChunkCursors(const DefaultInitVector<uint64_t>& items, int shift, std::size_t chunks,
                   std::vector<std::size_t>& cursor) {
   const std::size_t n = items.size(), per = (n + chunks - 1) / chunks;
@@ -95,34 +96,77 @@ bool ChunkCursors(const DefaultInitVector<uint64_t>& items, int shift, std::size
   return moves;
 }
 
+// The stable pass on the digit at `shift`, chunks in parallel, into `to`.
+// False when cancelled.
+bool ScatterChunks(const DefaultInitVector<uint64_t>& items, int shift, std::size_t chunks,
+                   std::vector<std::size_t>& cursor, DefaultInitVector<uint64_t>& to,
+                   const std::atomic<bool>* cancel) {
+  const std::size_t n = items.size(), per = (n + chunks - 1) / chunks;
+  std::atomic<bool> stopped{false};
+  tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
+    std::size_t* next = &cursor[c * kPackedBuckets];
+    for (std::size_t i = c * per; i < std::min(n, (c + 1) * per); ++i) {
+      if (CancelledAt(i, cancel)) {
+        stopped.store(true, std::memory_order_relaxed);
+        return;
+      }
+      to[next[(items[i] >> shift) & (kPackedBuckets - 1)]++] = items[i];
+    }
+  });
+  return !stopped.load();
+}
+
+// LSD passes of 8-bit digits over key bits [0, low_bits) of the m items at
+// `a`, with `b` as scratch; the sorted items end at `a`. A bucket of the top
+// digit is usually small enough that these passes run in cache.
+void SortLowBits(uint64_t* a, uint64_t* b, std::size_t m, int low_bits) {
+  constexpr int kBits = 8;
+  constexpr std::size_t kDigits = std::size_t{1} << kBits;
+  std::array<std::size_t, kDigits> start;
+  uint64_t *from = a, *to = b;
+  for (int shift = 32; shift < 32 + low_bits; shift += kBits) {
+    start.fill(0);
+    for (std::size_t i = 0; i < m; ++i) ++start[(from[i] >> shift) & (kDigits - 1)];
+    if (*std::max_element(start.begin(), start.end()) == m) continue;  // nothing would move
+    std::size_t sum = 0;
+    for (auto& s : start) sum += std::exchange(s, sum);
+    for (std::size_t i = 0; i < m; ++i) to[start[(from[i] >> shift) & (kDigits - 1)]++] = from[i];
+    std::swap(from, to);
+  }
+  if (from != a) std::copy(from, from + m, a);
+}
+
 }  // namespace
 
 bool RadixSortPacked(DefaultInitVector<uint64_t>& items, int key_bits,
                      const std::atomic<bool>* cancel) {
   if (key_bits <= 0) return !IsCancelled(cancel);
   key_bits = std::min(key_bits, 32);
-  const std::size_t n = items.size(), chunks = PassChunks(n), per = (n + chunks - 1) / chunks;
+  const int low_bits = std::max(0, key_bits - kPackedDigitBits);
+  const std::size_t n = items.size(), chunks = PassChunks(n);
   // Each pass writes every slot; its first touches the pages where it polls.
   DefaultInitVector<uint64_t> tmp(n);
   std::vector<std::size_t> cursor(chunks * kPackedBuckets);
-  for (int shift = 32; shift < 32 + key_bits; shift += kPackedDigitBits) {
-    if (IsCancelled(cancel)) return false;
-    if (!ChunkCursors(items, shift, chunks, cursor)) continue;
-    std::atomic<bool> stopped{false};
-    tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
-      std::size_t* to = &cursor[c * kPackedBuckets];
-      for (std::size_t i = c * per; i < std::min(n, (c + 1) * per); ++i) {
-        if (CancelledAt(i, cancel)) {
-          stopped.store(true, std::memory_order_relaxed);
-          return;
-        }
-        tmp[to[(items[i] >> shift) & (kPackedBuckets - 1)]++] = items[i];
-      }
-    });
-    if (stopped.load()) return false;
+  if (IsCancelled(cancel)) return false;
+  // Most significant digit first, over the whole array: it splits the items
+  // into up to 1024 buckets, [bucket[d], bucket[d + 1]).
+  const bool moves = ChunkCursors(items, 32 + low_bits, chunks, cursor);
+  std::vector<std::size_t> bucket(cursor.begin(), cursor.begin() + kPackedBuckets);
+  bucket.push_back(n);
+  if (moves) {
+    if (!ScatterChunks(items, 32 + low_bits, chunks, cursor, tmp, cancel)) return false;
     items.swap(tmp);
   }
-  return true;
+  if (low_bits == 0) return true;
+  // Then each bucket by the rest of the key, buckets in parallel.
+  std::atomic<bool> stopped{false};
+  tbb::parallel_for(std::size_t{0}, kPackedBuckets, [&](std::size_t d) {
+    if (IsCancelled(cancel)) stopped.store(true, std::memory_order_relaxed);
+    if (stopped.load(std::memory_order_relaxed) || bucket[d + 1] - bucket[d] < 2) return;
+    SortLowBits(items.data() + bucket[d], tmp.data() + bucket[d], bucket[d + 1] - bucket[d],
+                low_bits);
+  });
+  return !stopped.load();
 }
 
 }  // namespace surfinspect

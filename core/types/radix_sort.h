@@ -20,12 +20,17 @@ bool RadixSortPairs(std::vector<uint64_t>& keys, std::vector<uint32_t>& values, 
                     const std::atomic<bool>* cancel = nullptr);
 
 // The same for pairs packed as key << 32 | value (key < 2^key_bits,
-// key_bits <= 32), with 10-bit digits: half the bytes of the unpacked form
-// move per pass, and each pass writes to fewer places at once. Each pass
-// runs in contiguous chunks on the calling task arena's threads (one chunk
-// per thread, at least 2^16 items each), and a pass whose digit is the same
-// for every item is skipped; the order is the same for any number of
-// threads, as the sort is stable.
+// key_bits <= 32), most significant digit first: one stable pass on the top
+// 10 bits of the key over the whole array, in contiguous chunks on the
+// calling task arena's threads (one chunk per thread, at least 2^16 items
+// each), then each of its up to 1024 buckets by the rest of the key with
+// 8-bit LSD passes, buckets in parallel; a pass whose digit every item
+// shares is skipped. One pass over memory instead of three for a 30-bit
+// Morton code; the order is the same for any number of threads, as the
+// sort is stable. Polls `cancel` every 2^16 items of the first pass and
+// before each bucket; returns false when it is set. A bucket that holds
+// most items (a cloud whose points all share the top digit) is sorted by
+// one thread.
 bool RadixSortPacked(DefaultInitVector<uint64_t>& items, int key_bits,
                      const std::atomic<bool>* cancel = nullptr);
 
