@@ -1,7 +1,7 @@
-// Stable LSD radix sorts with 11-bit digits: O(n) per pass, so a 31-bit
-// key takes 3 passes. The link-clustering voxel grid sorts points by packed
-// cell key with them, and the batch closest-point queries sort points by
-// Morton code.
+// Stable radix sorts, O(n) per pass. The link-clustering voxel grid sorts
+// points by packed cell key with the pair sort (LSD, 11-bit digits: three
+// passes for a 31-bit key), and the batch closest-point queries sort points
+// by Morton code with the packed one (below).
 #pragma once
 
 #include <atomic>
