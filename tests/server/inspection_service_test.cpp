@@ -365,6 +365,28 @@ TEST(InspectionService, AnInlineMeshIndexThatDoesNotFitIsRefusedBeforeItIsBuilt)
   EXPECT_TRUE(ok.ok()) << ok.error_message();
 }
 
+// A packed cloud is charged for its declared grid, not for its bytes: a
+// 125 kB request for a million points does not fit a 16 MiB budget (72 B a
+// point), and the same grid of 100x100 does.
+TEST(InspectionService, APackedCloudIsChargedForItsWholeGrid) {
+  testing::ServerProcess server({"--max-memory-mb", "16"});
+  ASSERT_TRUE(server.started());
+  RawCalls raw(server.target());
+  using S = v1::InspectionService::Stub;
+  auto filter = [&](uint32_t side) {
+    v1::FilterRequest r;
+    r.mutable_cloud()->set_width(side);
+    r.mutable_cloud()->set_height(side);
+    r.mutable_cloud()->set_valid_bits(std::string((side * side + 7) / 8, '\0'));
+    return raw.Call<v1::FilterRequest, v1::FilterResponse>(&S::Filter, r);
+  };
+  const grpc::Status big = filter(1000);
+  EXPECT_EQ(big.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << big.error_message();
+  EXPECT_NE(big.error_message().find("memory"), std::string::npos) << big.error_message();
+  const grpc::Status small = filter(100);
+  EXPECT_NE(small.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << small.error_message();
+}
+
 TEST(InspectionService, BadRequestsGetTheRightCodeAndTheServerStaysUp) {
   testing::ServerProcess server({"--max-points", "2000000", "--max-triangles", "100000"});
   ASSERT_TRUE(server.started());
@@ -395,6 +417,23 @@ TEST(InspectionService, BadRequestsGetTheRightCodeAndTheServerStaysUp) {
       {"inf coordinate", {filter(cloud(4, 4, 192, INFINITY)), StatusCode::INVALID_ARGUMENT}});
   cases.push_back(
       {"too many points", {filter(cloud(5000, 5000, 12)), StatusCode::RESOURCE_EXHAUSTED}});
+  // Packed clouds (valid_bits): a few bytes can declare many points, and
+  // the points limit still holds; malformed bits are refused by name.
+  auto packed = [](uint32_t w, uint32_t h, std::size_t bit_bytes) {
+    v1::PointCloud c;
+    c.set_width(w);
+    c.set_height(h);
+    c.set_valid_bits(std::string(bit_bytes, '\0'));  // no point has data; xyz stays empty
+    return c;
+  };
+  cases.push_back({"packed: too many points",
+                   {filter(packed(5000, 5000, 5000 * 5000 / 8)), StatusCode::RESOURCE_EXHAUSTED}});
+  cases.push_back({"packed: bits of the wrong length",
+                   {filter(packed(4, 4, 3)), StatusCode::INVALID_ARGUMENT}});
+  v1::PointCloud miscounted = packed(4, 4, 2);
+  miscounted.set_valid_bits(std::string("\x01\0", 2));  // one point set, xyz empty
+  cases.push_back(
+      {"packed: xyz short of the bits", {filter(miscounted), StatusCode::INVALID_ARGUMENT}});
   v1::FilterSettings neg;
   neg.set_link_distance_mm(-1);
   cases.push_back(
