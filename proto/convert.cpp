@@ -51,21 +51,27 @@ absl::StatusOr<PointCloud> CloudFromBytes(const std::string& xyz, uint32_t width
   if (xyz.size() != n * 12)
     return Invalid(field,
                    absl::StrCat("xyz holds ", xyz.size(), " bytes but width*height*12 = ", n * 12));
+  return CloudFromBlocks(width, height, field,
+                         [&](uint64_t, uint64_t first, uint64_t last, Eigen::Vector3f* points) {
+                           std::memcpy(static_cast<void*>(points + first), xyz.data() + 12 * first,
+                                       12 * (last - first));
+                         });
+}
+
+absl::StatusOr<PointCloud> CloudFromBlocks(
+    uint32_t width, uint32_t height, const std::string& field,
+    absl::FunctionRef<void(uint64_t b, uint64_t first, uint64_t last, Eigen::Vector3f* points)>
+        fill) {
+  const uint64_t n = uint64_t{width} * height;
   PointCloud c;
   c.width = width;
   c.height = height;
   c.points.resize(n);
-  // Copied and checked a block at a time, so the check reads what the copy
-  // just left in cache, on the calling arena's threads (which also share
-  // the faulting-in of the new pages). The lowest failing block names the
-  // first infinite point, as one serial Validate would.
-  constexpr uint64_t kBlock = 1 << 16;  // points
-  const uint64_t blocks = (n + kBlock - 1) / kBlock;
+  const uint64_t blocks = (n + kCloudBlock - 1) / kCloudBlock;
   std::vector<absl::Status> failed(blocks);
   tbb::parallel_for(uint64_t{0}, blocks, [&](uint64_t b) {
-    const uint64_t first = b * kBlock, last = std::min(n, first + kBlock);
-    std::memcpy(static_cast<void*>(c.points.data() + first), xyz.data() + 12 * first,
-                12 * (last - first));
+    const uint64_t first = b * kCloudBlock, last = std::min(n, first + kCloudBlock);
+    fill(b, first, last, c.points.data());
     failed[b] = c.ValidatePoints(first, last);
   });
   for (const absl::Status& st : failed)

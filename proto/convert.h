@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 #include <string>
 
+#include "absl/functional/function_ref.h"
 #include "absl/status/statusor.h"
 #include "core/errormap/error_map.h"
 #include "core/filter/link_clustering.h"
@@ -41,6 +42,19 @@ absl::Status CheckCloudShape(uint64_t width, uint64_t height, const std::string&
 // Raw little-endian xyz bytes (width*height*12) into a cloud.
 absl::StatusOr<PointCloud> CloudFromBytes(const std::string& xyz, uint32_t width, uint32_t height,
                                           const std::string& field);
+// Points per block of CloudFromBlocks.
+constexpr uint64_t kCloudBlock = 1 << 16;
+// A width x height cloud whose points fill(b, first, last, points) writes,
+// block b being points [first, last) = [b, b + 1) * kCloudBlock (the last
+// one shorter). Blocks are written and checked in parallel on the calling
+// arena's threads, each checked while it is still in cache (the threads
+// also share the faulting-in of the new pages); the lowest failing block
+// names the first infinite point, as one serial Validate would, in an
+// InvalidArgument naming `field`.
+absl::StatusOr<PointCloud> CloudFromBlocks(
+    uint32_t width, uint32_t height, const std::string& field,
+    absl::FunctionRef<void(uint64_t b, uint64_t first, uint64_t last, Eigen::Vector3f* points)>
+        fill);
 
 // A cloud whose xyz bytes arrive in chunks (the Inspect stream). Each chunk
 // is copied straight into the points: no staging buffer, no second copy.

@@ -1,13 +1,12 @@
 #include "proto/packed_cloud.h"
 
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cstring>
 #include <limits>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "proto/convert.h"
 
 namespace surfinspect::wire {
 namespace {
@@ -18,9 +17,8 @@ absl::Status Invalid(const std::string& field, absl::string_view why) {
   return absl::InvalidArgumentError(absl::StrCat(field, ": ", why));
 }
 
-// Points per block of the parallel unpacking: a multiple of 8, so a block
-// starts on a byte of valid_bits.
-constexpr uint64_t kBlock = 1 << 16;
+// CloudFromBlocks' blocks start on a byte of valid_bits.
+static_assert(kCloudBlock % 8 == 0);
 
 bool BitSet(const std::string& bits, uint64_t i) {
   return (static_cast<uint8_t>(bits[i / 8]) >> (i % 8)) & 1u;
@@ -75,39 +73,28 @@ absl::StatusOr<PointCloud> CloudFromPackedBytes(const std::string& xyz,
                             " points need ", (n + 7) / 8));
   if (n % 8 != 0 && (static_cast<uint8_t>(valid_bits.back()) >> (n % 8)) != 0)
     return Invalid(field, "valid_bits sets a bit past the last point");
-  const uint64_t blocks = (n + kBlock - 1) / kBlock;
+  const uint64_t blocks = (n + kCloudBlock - 1) / kCloudBlock;
   std::vector<uint64_t> offset(blocks + 1, 0);  // first packed point of each block
   for (uint64_t b = 0; b < blocks; ++b)
     offset[b + 1] =
-        offset[b] + CountBits(valid_bits, b * kBlock / 8,
-                              std::min<uint64_t>(valid_bits.size(), (b + 1) * kBlock / 8));
+        offset[b] + CountBits(valid_bits, b * kCloudBlock / 8,
+                              std::min<uint64_t>(valid_bits.size(), (b + 1) * kCloudBlock / 8));
   if (xyz.size() != 12 * offset[blocks])
     return Invalid(
         field, absl::StrCat("xyz holds ", xyz.size(), " bytes but valid_bits sets ", offset[blocks],
                             " points (", 12 * offset[blocks], " bytes)"));
-  PointCloud c;
-  c.width = width;
-  c.height = height;
-  c.points.resize(n);
-  // Each block writes its points, then checks them while they are in cache;
-  // the lowest failing block names the first infinite point.
-  std::vector<absl::Status> failed(blocks);
-  tbb::parallel_for(uint64_t{0}, blocks, [&](uint64_t b) {
-    const uint64_t first = b * kBlock, last = std::min(n, first + kBlock);
-    const char* in = xyz.data() + 12 * offset[b];
-    for (uint64_t i = first; i < last; ++i) {
-      if (BitSet(valid_bits, i)) {
-        std::memcpy(c.points[i].data(), in, 12);
-        in += 12;
-      } else {
-        c.points[i] = kNoData;
-      }
-    }
-    failed[b] = c.ValidatePoints(first, last);
-  });
-  for (const absl::Status& st : failed)
-    if (!st.ok()) return Invalid(field, st.message());
-  return c;
+  return CloudFromBlocks(width, height, field,
+                         [&](uint64_t b, uint64_t first, uint64_t last, Eigen::Vector3f* points) {
+                           const char* in = xyz.data() + 12 * offset[b];
+                           for (uint64_t i = first; i < last; ++i) {
+                             if (BitSet(valid_bits, i)) {
+                               std::memcpy(points[i].data(), in, 12);
+                               in += 12;
+                             } else {
+                               points[i] = kNoData;
+                             }
+                           }
+                         });
 }
 
 }  // namespace surfinspect::wire
