@@ -5,6 +5,7 @@
 
 #include "core/filter/link_clustering.h"
 #include "core/filter/link_row_masks_avx2.h"
+#include "core/filter/link_row_masks_avx512.h"
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -12,11 +13,11 @@
 
 namespace surfinspect::link_row {
 
-namespace {
-bool UseAvx2(RowIsa isa) {
-  return isa == RowIsa::kAvx2 || (isa == RowIsa::kAuto && RowIsaSupported(RowIsa::kAvx2));
+RowIsa ResolveRowIsa(RowIsa isa) {
+  if (isa != RowIsa::kAuto) return isa;
+  if (RowIsaSupported(RowIsa::kAvx512)) return RowIsa::kAvx512;
+  return RowIsaSupported(RowIsa::kAvx2) ? RowIsa::kAvx2 : RowIsa::kSse2;
 }
-}  // namespace
 
 // Copies w points into the SoA row (SSE2: 4 points = 3 loads, 7 shuffles).
 void Transpose(const Eigen::Vector3f* pts, uint32_t w, RowSoA& row, RowIsa isa) {
@@ -24,7 +25,9 @@ void Transpose(const Eigen::Vector3f* pts, uint32_t w, RowSoA& row, RowIsa isa) 
   float* __restrict y = row.c(1);
   float* __restrict z = row.c(2);
   const float* f = pts[0].data();
-  if (UseAvx2(isa)) return avx2::Transpose(f, w, x, y, z);
+  isa = ResolveRowIsa(isa);
+  if (isa == RowIsa::kAvx512) return avx512::Transpose(f, w, x, y, z);
+  if (isa == RowIsa::kAvx2) return avx2::Transpose(f, w, x, y, z);
   uint32_t i = 0;
 #if defined(__SSE2__)
   for (; i + 4 <= w; i += 4, f += 12) {
@@ -123,19 +126,26 @@ bool RowBits(const RowSoA& cur, const RowSoA& up, uint32_t words, float r2, cons
 }  // namespace
 
 bool RowIsaSupported(RowIsa isa) {
+  // __builtin_cpu_supports also checks that the OS saves the registers.
   static const bool avx2 = __builtin_cpu_supports("avx2");
-  return isa != RowIsa::kAvx2 || avx2;
+  static const bool avx512 =
+      __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
+  if (isa == RowIsa::kAvx2) return avx2;
+  if (isa == RowIsa::kAvx512) return avx512;
+  return true;
 }
 
 bool ComputeMasks(const RowSoA& cur, const RowSoA* up, bool diagonals, uint32_t words,
                   float link_distance_sq, const RowMasks& masks, RowIsa isa) {
-  if (UseAvx2(isa)) {
+  isa = ResolveRowIsa(isa);
+  if (isa != RowIsa::kSse2) {
     const float* const c[3] = {cur.c(0), cur.c(1), cur.c(2)};
     const float* const u[3] = {up ? up->c(0) : nullptr, up ? up->c(1) : nullptr,
                                up ? up->c(2) : nullptr};
     uint64_t* const m[5] = {masks.valid, masks.west, masks.north_west, masks.north,
                             masks.north_east};
-    return avx2::RowBits(c, up ? u : nullptr, diagonals, words, link_distance_sq, m);
+    return (isa == RowIsa::kAvx512 ? avx512::RowBits : avx2::RowBits)(
+        c, up ? u : nullptr, diagonals, words, link_distance_sq, m);
   }
   if (!up) return RowBits<false, false>(cur, cur, words, link_distance_sq, masks);
   if (diagonals) return RowBits<true, true>(cur, *up, words, link_distance_sq, masks);

@@ -31,11 +31,14 @@ struct RowMasks {
   uint64_t *valid, *west, *north_west, *north, *north_east;
 };
 
-// The row kernels' instruction set. kAuto takes AVX2 (8 pixels per
-// instruction, link_row_masks_avx2.h) where the CPU has it, else SSE2; the
-// rows and masks are the same bits in each.
-enum class RowIsa { kAuto, kSse2, kAvx2 };
+// The row kernels' instruction set. kAuto takes the widest the CPU has:
+// AVX-512 F + DQ (16 pixels per instruction, link_row_masks_avx512.h), AVX2
+// (8, link_row_masks_avx2.h) or SSE2 (4); the rows and masks are the same
+// bits in each.
+enum class RowIsa { kAuto, kSse2, kAvx2, kAvx512 };
 bool RowIsaSupported(RowIsa isa);
+// The instruction set `isa` runs as: kAuto resolved to the widest supported.
+RowIsa ResolveRowIsa(RowIsa isa);
 
 // Copies w points into the SoA row (SSE2: 4 points = 3 loads, 7 shuffles).
 // `isa` must be supported.

@@ -18,11 +18,12 @@ bool Bit(const std::vector<uint64_t>& bits, uint32_t i) { return (bits[i / 64] >
 // ties included (the SIMD path may not round or compare differently).
 // Each instruction set's row pass, checked on its own against the scalar
 // predicate: core/filter/link_row_masks.cpp (SSE2) and
-// core/filter/link_row_masks_avx2.cpp (only where the CPU has AVX2).
+// core/filter/link_row_masks_avx2.cpp and link_row_masks_avx512.cpp (only
+// where the CPU has them).
 class LinkRowMasks : public ::testing::TestWithParam<RowIsa> {
  protected:
   void SetUp() override {
-    if (!RowIsaSupported(GetParam())) GTEST_SKIP() << "this CPU has no AVX2";
+    if (!RowIsaSupported(GetParam())) GTEST_SKIP() << "this CPU lacks the instruction set";
   }
 };
 
@@ -107,6 +108,13 @@ TEST_P(LinkRowMasks, FirstRowHasNoVerticalLinksAndInfinityIsReported) {
   pts[69] = {0.f, -INFINITY, NAN};
   Transpose(pts.data(), 70, row);
   EXPECT_TRUE(ComputeMasks(row, nullptr, true, 2, 0.25f, m, GetParam()));
+  // Also where every pixel around it is invalid: a pass that skips such
+  // pixels' link tests must still see the infinity.
+  std::fill(pts.begin(), pts.end(), Eigen::Vector3f(NAN, NAN, NAN));
+  pts[40] = {INFINITY, NAN, 0.f};
+  Transpose(pts.data(), 70, row);
+  EXPECT_TRUE(ComputeMasks(row, nullptr, true, 2, 0.25f, m, GetParam()));
+  EXPECT_EQ(storage[0] | storage[1], 0u);
 }
 
 // Each set's transpose gives the points' coordinates plane by plane, NaN
@@ -114,7 +122,7 @@ TEST_P(LinkRowMasks, FirstRowHasNoVerticalLinksAndInfinityIsReported) {
 TEST_P(LinkRowMasks, TransposeCopiesEveryCoordinate) {
   std::mt19937 rng(4);
   std::uniform_real_distribution<float> u(-100.f, 100.f);
-  for (uint32_t w : {1u, 7u, 8u, 9u, 64u, 70u, 1024u}) {
+  for (uint32_t w : {1u, 7u, 8u, 9u, 15u, 16u, 17u, 33u, 64u, 70u, 1024u}) {
     std::vector<Eigen::Vector3f> pts(w);
     for (auto& p : pts) p = {u(rng), u(rng), u(rng)};
     pts[0].y() = NAN;
@@ -162,10 +170,12 @@ TEST(LinkRowRuns, StartsEndsAndNextBitMatchTheirDefinitions) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(EachIsa, LinkRowMasks, ::testing::Values(RowIsa::kSse2, RowIsa::kAvx2),
+INSTANTIATE_TEST_SUITE_P(EachIsa, LinkRowMasks,
+                         ::testing::Values(RowIsa::kSse2, RowIsa::kAvx2, RowIsa::kAvx512),
                          [](const ::testing::TestParamInfo<RowIsa>& i) {
-                           return i.param == RowIsa::kAvx2 ? std::string("Avx2")
-                                                           : std::string("Sse2");
+                           return i.param == RowIsa::kAvx512 ? std::string("Avx512")
+                                  : i.param == RowIsa::kAvx2 ? std::string("Avx2")
+                                                             : std::string("Sse2");
                          });
 
 }  // namespace

@@ -1,0 +1,92 @@
+#include "core/filter/link_row_masks_avx512.h"
+
+#include <immintrin.h>
+
+namespace surfinspect::link_row::avx512 {
+namespace {
+
+// 16 link tests at once: PointsLinked's float operations in its order
+// (no FMA: the file is built with -ffp-contract=off), an ordered <= as
+// SSE2's cmpleps, so NaN never links.
+inline uint64_t Link16(__m512 px, __m512 py, __m512 pz, const float* bx, const float* by,
+                       const float* bz, __m512 r2) {
+  const __m512 dx = _mm512_sub_ps(px, _mm512_loadu_ps(bx));
+  const __m512 dy = _mm512_sub_ps(py, _mm512_loadu_ps(by));
+  const __m512 dz = _mm512_sub_ps(pz, _mm512_loadu_ps(bz));
+  const __m512 d2 = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)),
+                                  _mm512_mul_ps(dz, dz));
+  return _mm512_cmp_ps_mask(d2, r2, _CMP_LE_OQ);
+}
+
+// vfpclassps categories: quiet NaN, +inf, -inf, signalling NaN.
+constexpr int kInfinite = 0x08 | 0x10;
+constexpr int kNotFinite = 0x01 | kInfinite | 0x80;
+
+template <bool kAbove, bool kDiagonals>
+bool Pass(const float* const cur[3], const float* const up[3], uint32_t words, float r2,
+          uint64_t* const masks[5]) {
+  const float *x = cur[0], *y = cur[1], *z = cur[2];
+  const float *ux = up[0], *uy = up[1], *uz = up[2];
+  const __m512 r = _mm512_set1_ps(r2);
+  __mmask16 any_inf = 0;
+  for (uint32_t k = 0; k < words; ++k) {
+    uint64_t valid = 0, west = 0, north_west = 0, north = 0, north_east = 0;
+    for (uint32_t j = 0; j < 64; j += 16) {
+      const uint32_t i = 64 * k + j;
+      const __m512 px = _mm512_loadu_ps(x + i), py = _mm512_loadu_ps(y + i),
+                   pz = _mm512_loadu_ps(z + i);
+      // Valid: every coordinate finite, which is what the other passes'
+      // x * 0 + y * 0 + z * 0 == 0 tests.
+      const __mmask16 bad = _mm512_fpclass_ps_mask(px, kNotFinite) |
+                            _mm512_fpclass_ps_mask(py, kNotFinite) |
+                            _mm512_fpclass_ps_mask(pz, kNotFinite);
+      if (bad != 0) {
+        any_inf |= _mm512_fpclass_ps_mask(px, kInfinite) | _mm512_fpclass_ps_mask(py, kInfinite) |
+                   _mm512_fpclass_ps_mask(pz, kInfinite);
+        if (bad == 0xffff) continue;  // no data links to nothing (as in the AVX2 pass)
+      }
+      valid |= uint64_t{static_cast<uint16_t>(~bad)} << j;
+      west |= Link16(px, py, pz, x + i - 1, y + i - 1, z + i - 1, r) << j;
+      if (kAbove) north |= Link16(px, py, pz, ux + i, uy + i, uz + i, r) << j;
+      if (kDiagonals) {
+        north_west |= Link16(px, py, pz, ux + i - 1, uy + i - 1, uz + i - 1, r) << j;
+        north_east |= Link16(px, py, pz, ux + i + 1, uy + i + 1, uz + i + 1, r) << j;
+      }
+    }
+    masks[0][k] = valid, masks[1][k] = west;
+    masks[2][k] = north_west, masks[3][k] = north, masks[4][k] = north_east;
+  }
+  return any_inf != 0;
+}
+
+}  // namespace
+
+bool RowBits(const float* const cur[3], const float* const up[3], bool diagonals, uint32_t words,
+             float link_distance_sq, uint64_t* const masks[5]) {
+  if (!up) return Pass<false, false>(cur, cur, words, link_distance_sq, masks);
+  if (diagonals) return Pass<true, true>(cur, up, words, link_distance_sq, masks);
+  return Pass<true, false>(cur, up, words, link_distance_sq, masks);
+}
+
+void Transpose(const float* f, uint32_t w, float* x, float* y, float* z) {
+  // Point p's coordinate a is float 3p + a of the 48 loaded (a: 0-15, b:
+  // 16-31, c: 32-47). Each plane takes its floats from a and b with one
+  // two-source permute (indices 0-31), then the rest from c (indices 16-31
+  // of the second permute's sources select c).
+  const __m512i ab_x = _mm512_setr_epi32(0, 3, 6, 9, 12, 15, 18, 21, 24, 27, 30, 0, 0, 0, 0, 0);
+  const __m512i ab_y = _mm512_setr_epi32(1, 4, 7, 10, 13, 16, 19, 22, 25, 28, 31, 0, 0, 0, 0, 0);
+  const __m512i ab_z = _mm512_setr_epi32(2, 5, 8, 11, 14, 17, 20, 23, 26, 29, 0, 0, 0, 0, 0, 0);
+  const __m512i c_x = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 17, 20, 23, 26, 29);
+  const __m512i c_y = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 18, 21, 24, 27, 30);
+  const __m512i c_z = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 16, 19, 22, 25, 28, 31);
+  uint32_t i = 0;
+  for (; i + 16 <= w; i += 16, f += 48) {
+    const __m512 a = _mm512_loadu_ps(f), b = _mm512_loadu_ps(f + 16), c = _mm512_loadu_ps(f + 32);
+    _mm512_storeu_ps(x + i, _mm512_permutex2var_ps(_mm512_permutex2var_ps(a, ab_x, b), c_x, c));
+    _mm512_storeu_ps(y + i, _mm512_permutex2var_ps(_mm512_permutex2var_ps(a, ab_y, b), c_y, c));
+    _mm512_storeu_ps(z + i, _mm512_permutex2var_ps(_mm512_permutex2var_ps(a, ab_z, b), c_z, c));
+  }
+  for (; i < w; ++i, f += 3) x[i] = f[0], y[i] = f[1], z[i] = f[2];
+}
+
+}  // namespace surfinspect::link_row::avx512

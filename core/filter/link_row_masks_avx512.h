@@ -1,0 +1,20 @@
+// The AVX-512 build of link_row_masks.cpp's transpose and row pass
+// (link_row_masks_avx512.cpp, compiled with -mavx512f -mavx512dq): 16 pixels
+// per instruction, the same float operations in the same order, compared
+// into mask registers, so every mask bit is the SSE2 pass's. Plain types
+// only, for the reason given in link_row_masks_avx2.h.
+#pragma once
+
+#include <cstdint>
+
+namespace surfinspect::link_row::avx512 {
+
+// As avx2::RowBits, 16 pixels at a time. Call only where AVX-512F and DQ run.
+bool RowBits(const float* const cur[3], const float* const up[3], bool diagonals, uint32_t words,
+             float link_distance_sq, uint64_t* const masks[5]);
+
+// As avx2::Transpose: 16 points per 3 loads, 6 permutes and 3 stores. Call
+// only where AVX-512F runs.
+void Transpose(const float* points, uint32_t w, float* x, float* y, float* z);
+
+}  // namespace surfinspect::link_row::avx512
