@@ -79,9 +79,12 @@ inline uint32_t NextBit(const uint64_t* bits, uint32_t words, uint32_t from) {
 }
 
 // Bounds of the pixels first..last of the row, which must all be valid.
-void BoundsOfLongRun(const RowSoA& row, uint32_t first, uint32_t last, float lo[3], float hi[3]);
-inline void Bounds(const RowSoA& row, uint32_t first, uint32_t last, float lo[3], float hi[3]) {
-  if (last - first >= 8) return BoundsOfLongRun(row, first, last, lo, hi);
+// The same bits in each instruction set, the sign of a zero included.
+void BoundsOfLongRun(const RowSoA& row, uint32_t first, uint32_t last, float lo[3], float hi[3],
+                     RowIsa isa = RowIsa::kAuto);
+inline void Bounds(const RowSoA& row, uint32_t first, uint32_t last, float lo[3], float hi[3],
+                   RowIsa isa = RowIsa::kAuto) {
+  if (last - first >= 8) return BoundsOfLongRun(row, first, last, lo, hi, isa);
   // Most runs of a scan are a pixel or two of an outlier: inline, scalar.
   for (int a = 0; a < 3; ++a) lo[a] = hi[a] = row.c(a)[first];
   for (uint32_t i = first + 1; i <= last; ++i)

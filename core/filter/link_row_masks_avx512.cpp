@@ -89,4 +89,53 @@ void Transpose(const float* f, uint32_t w, float* x, float* y, float* z) {
   for (; i < w; ++i, f += 3) x[i] = f[0], y[i] = f[1], z[i] = f[2];
 }
 
+// GCC 12's unmasked _mm512_min_ps, _mm512_max_ps and extracts pass an
+// "undefined" register that its own -Wuninitialized flags; the zero-masked
+// forms with every lane set are the same instructions' results.
+constexpr __mmask16 kAll = 0xffff;
+inline __m512 Min(__m512 a, __m512 b) { return _mm512_maskz_min_ps(kAll, a, b); }
+inline __m512 Max(__m512 a, __m512 b) { return _mm512_maskz_max_ps(kAll, a, b); }
+
+// The least (kMax: greatest) of the 16 lanes, by halving.
+template <bool kMax>
+float Reduce(__m512 v) {
+  auto op8 = [](__m256 a, __m256 b) { return kMax ? _mm256_max_ps(a, b) : _mm256_min_ps(a, b); };
+  auto op4 = [](__m128 a, __m128 b) { return kMax ? _mm_max_ps(a, b) : _mm_min_ps(a, b); };
+  const __m256 h =
+      op8(_mm512_maskz_extractf32x8_ps(0xff, v, 0), _mm512_maskz_extractf32x8_ps(0xff, v, 1));
+  __m128 q = op4(_mm256_castps256_ps128(h), _mm256_extractf128_ps(h, 1));
+  q = op4(q, _mm_movehl_ps(q, q));
+  q = op4(q, _mm_shuffle_ps(q, q, 1));
+  return _mm_cvtss_f32(q);
+}
+
+bool BoundsOfRun(const float* const row[3], uint32_t first, uint32_t last, float lo[3],
+                 float hi[3]) {
+  const __m512 inf = _mm512_set1_ps(__builtin_inff()),
+               minus_inf = _mm512_set1_ps(-__builtin_inff());
+  __m512 vlo[3] = {inf, inf, inf}, vhi[3] = {minus_inf, minus_inf, minus_inf};
+  uint32_t i = first;
+  for (; i + 15 <= last; i += 16)
+    for (int a = 0; a < 3; ++a) {
+      const __m512 q = _mm512_loadu_ps(row[a] + i);
+      vlo[a] = Min(vlo[a], q);
+      vhi[a] = Max(vhi[a], q);
+    }
+  if (i <= last) {
+    // The tail's other lanes read as +inf for the minimum, -inf for the
+    // maximum; a masked load touches no memory outside its mask.
+    const auto tail = static_cast<__mmask16>((1u << (last + 1 - i)) - 1);
+    for (int a = 0; a < 3; ++a) {
+      vlo[a] = Min(vlo[a], _mm512_mask_loadu_ps(inf, tail, row[a] + i));
+      vhi[a] = Max(vhi[a], _mm512_mask_loadu_ps(minus_inf, tail, row[a] + i));
+    }
+  }
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = Reduce<false>(vlo[a]);
+    hi[a] = Reduce<true>(vhi[a]);
+    if (lo[a] == 0 || hi[a] == 0) return false;
+  }
+  return true;
+}
+
 }  // namespace surfinspect::link_row::avx512

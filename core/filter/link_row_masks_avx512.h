@@ -17,4 +17,11 @@ bool RowBits(const float* const cur[3], const float* const up[3], bool diagonals
 // only where AVX-512F runs.
 void Transpose(const float* points, uint32_t w, float* x, float* y, float* z);
 
+// Bounds of the pixels first..last of the planes (all valid), 16 at a
+// time. Returns false, leaving the caller to its 4-lane reduction, where a
+// bound is zero: min and max ignore the sign of a zero, so only there can
+// another lane order give another bit pattern. Call only where AVX-512F runs.
+bool BoundsOfRun(const float* const row[3], uint32_t first, uint32_t last, float lo[3],
+                 float hi[3]);
+
 }  // namespace surfinspect::link_row::avx512
