@@ -11,7 +11,6 @@
 // or without the coherent start.
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -21,9 +20,9 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/distance/mesh_index.h"
+#include "core/distance/morton_order.h"
 #include "core/types/cancel.h"
 #include "core/types/default_init_vector.h"
-#include "core/types/radix_sort.h"
 
 namespace surfinspect {
 namespace {
@@ -34,81 +33,6 @@ constexpr std::size_t kChunk = 256;  // points per chunk: the unit of work and o
 // large compared with their reach), a chunk whose first this many tries
 // certified fewer than a quarter stops trying. The answers are the same.
 constexpr std::size_t kCertificateProbe = 16;
-
-// Spreads the low 10 bits of v to every third bit (Morton interleave).
-constexpr uint32_t Spread10(uint32_t v) {
-  v &= 0x3ff;
-  v = (v | (v << 16)) & 0x30000ff;
-  v = (v | (v << 8)) & 0x300f00f;
-  v = (v | (v << 4)) & 0x30c30c3;
-  v = (v | (v << 2)) & 0x9249249;
-  return v;
-}
-
-// Spread10 of every 10-bit value, so a code costs three loads (4 KiB, in
-// the L1 cache) instead of three chains of shifts.
-struct SpreadTable {
-  uint32_t of[1024];
-  constexpr SpreadTable() : of() {
-    for (uint32_t v = 0; v < 1024; ++v) of[v] = Spread10(v);
-  }
-};
-constexpr SpreadTable kSpread;
-
-// ComputeBounds on the arena's threads. The minimum and maximum of the same
-// points found in another order differ at most in the sign of a zero
-// bound, which the Morton codes below do not see: the extent and every
-// difference p - min keep their values, and a zero of either sign falls in
-// cell 0.
-Bounds3 ParallelBounds(const PointCloud& cloud) {
-  return tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, cloud.size(), kCancelStride), Bounds3{},
-      [&](const tbb::blocked_range<std::size_t>& block, Bounds3 b) {
-        for (std::size_t i = block.begin(); i != block.end(); ++i)
-          if (PointCloud::IsValid(cloud.points[i])) b.Extend(cloud.points[i].cast<double>());
-        return b;
-      },
-      [](Bounds3 a, const Bounds3& b) {
-        a.min = a.min.cwiseMin(b.min);
-        a.max = a.max.cwiseMax(b.max);
-        return a;
-      });
-}
-
-// Visiting order for an unorganized cloud: 30-bit Morton codes on a 1024^3
-// grid over the bounds, sorted by a stable radix sort (equal codes keep
-// input order). Invalid points go last. The codes are computed in parallel
-// blocks (each depends only on its point). The result holds code << 32 |
-// point index, in visiting order; empty if cancelled.
-DefaultInitVector<uint64_t> MortonOrder(const PointCloud& cloud, const std::atomic<bool>* cancel) {
-  const Bounds3 bounds = ParallelBounds(cloud);
-  const std::size_t n = cloud.size();
-  const double extent = bounds.empty() ? 0.0 : (bounds.max - bounds.min).maxCoeff();
-  const double scale = extent > 0 ? 1023.0 / extent : 0.0;
-  DefaultInitVector<uint64_t> items(n);  // code << 32 | point index, written below
-  std::atomic<bool> stopped{false};
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, n, kCancelStride),
-      [&](const tbb::blocked_range<std::size_t>& block) {
-        if (IsCancelled(cancel)) {
-          stopped.store(true, std::memory_order_relaxed);
-          return;
-        }
-        for (std::size_t i = block.begin(); i != block.end(); ++i) {
-          const Eigen::Vector3f& p = cloud.points[i];
-          uint64_t code = uint64_t{1} << 30;
-          if (PointCloud::IsValid(p)) {
-            std::array<uint64_t, 3> q;
-            for (int a = 0; a < 3; ++a)
-              q[a] = static_cast<uint64_t>(std::clamp((p[a] - bounds.min[a]) * scale, 0.0, 1023.0));
-            code = kSpread.of[q[0]] | (kSpread.of[q[1]] << 1) | (kSpread.of[q[2]] << 2);
-          }
-          items[i] = code << 32 | i;
-        }
-      });
-  if (stopped.load() || !RadixSortPacked(items, 31, cancel)) return {};
-  return items;
-}
 
 absl::Status CheckInputs(const PointCloud& points, const Eigen::Isometry3d& mesh_from_points,
                          const BatchQuerySettings& settings) {

@@ -2,6 +2,8 @@
 
 #include <immintrin.h>
 
+#include "core/types/transpose16_avx512.h"
+
 namespace surfinspect::link_row::avx512 {
 namespace {
 
@@ -18,9 +20,8 @@ inline uint64_t Link16(__m512 px, __m512 py, __m512 pz, const float* bx, const f
   return _mm512_cmp_ps_mask(d2, r2, _CMP_LE_OQ);
 }
 
-// vfpclassps categories: quiet NaN, +inf, -inf, signalling NaN.
-constexpr int kInfinite = 0x08 | 0x10;
-constexpr int kNotFinite = 0x01 | kInfinite | 0x80;
+using surfinspect::avx512::kInfinite;
+using surfinspect::avx512::NotFinite;
 
 template <bool kAbove, bool kDiagonals>
 bool Pass(const float* const cur[3], const float* const up[3], uint32_t words, float r2,
@@ -37,9 +38,7 @@ bool Pass(const float* const cur[3], const float* const up[3], uint32_t words, f
                    pz = _mm512_loadu_ps(z + i);
       // Valid: every coordinate finite, which is what the other passes'
       // x * 0 + y * 0 + z * 0 == 0 tests.
-      const __mmask16 bad = _mm512_fpclass_ps_mask(px, kNotFinite) |
-                            _mm512_fpclass_ps_mask(py, kNotFinite) |
-                            _mm512_fpclass_ps_mask(pz, kNotFinite);
+      const __mmask16 bad = NotFinite(px, py, pz);
       if (bad != 0) {
         any_inf |= _mm512_fpclass_ps_mask(px, kInfinite) | _mm512_fpclass_ps_mask(py, kInfinite) |
                    _mm512_fpclass_ps_mask(pz, kInfinite);
@@ -69,40 +68,23 @@ bool RowBits(const float* const cur[3], const float* const up[3], bool diagonals
 }
 
 void Transpose(const float* f, uint32_t w, float* x, float* y, float* z) {
-  // Point p's coordinate a is float 3p + a of the 48 loaded (a: 0-15, b:
-  // 16-31, c: 32-47). Each plane takes its floats from a and b with one
-  // two-source permute (indices 0-31), then the rest from c (indices 16-31
-  // of the second permute's sources select c).
-  const __m512i ab_x = _mm512_setr_epi32(0, 3, 6, 9, 12, 15, 18, 21, 24, 27, 30, 0, 0, 0, 0, 0);
-  const __m512i ab_y = _mm512_setr_epi32(1, 4, 7, 10, 13, 16, 19, 22, 25, 28, 31, 0, 0, 0, 0, 0);
-  const __m512i ab_z = _mm512_setr_epi32(2, 5, 8, 11, 14, 17, 20, 23, 26, 29, 0, 0, 0, 0, 0, 0);
-  const __m512i c_x = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 17, 20, 23, 26, 29);
-  const __m512i c_y = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 18, 21, 24, 27, 30);
-  const __m512i c_z = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 16, 19, 22, 25, 28, 31);
   uint32_t i = 0;
   for (; i + 16 <= w; i += 16, f += 48) {
-    const __m512 a = _mm512_loadu_ps(f), b = _mm512_loadu_ps(f + 16), c = _mm512_loadu_ps(f + 32);
-    _mm512_storeu_ps(x + i, _mm512_permutex2var_ps(_mm512_permutex2var_ps(a, ab_x, b), c_x, c));
-    _mm512_storeu_ps(y + i, _mm512_permutex2var_ps(_mm512_permutex2var_ps(a, ab_y, b), c_y, c));
-    _mm512_storeu_ps(z + i, _mm512_permutex2var_ps(_mm512_permutex2var_ps(a, ab_z, b), c_z, c));
+    __m512 px, py, pz;
+    surfinspect::avx512::Transpose16(f, px, py, pz);
+    _mm512_storeu_ps(x + i, px);
+    _mm512_storeu_ps(y + i, py);
+    _mm512_storeu_ps(z + i, pz);
   }
   for (; i < w; ++i, f += 3) x[i] = f[0], y[i] = f[1], z[i] = f[2];
 }
-
-// GCC 12's unmasked _mm512_min_ps, _mm512_max_ps and extracts pass an
-// "undefined" register that its own -Wuninitialized flags; the zero-masked
-// forms with every lane set are the same instructions' results.
-constexpr __mmask16 kAll = 0xffff;
-inline __m512 Min(__m512 a, __m512 b) { return _mm512_maskz_min_ps(kAll, a, b); }
-inline __m512 Max(__m512 a, __m512 b) { return _mm512_maskz_max_ps(kAll, a, b); }
 
 // The least (kMax: greatest) of the 16 lanes, by halving.
 template <bool kMax>
 float Reduce(__m512 v) {
   auto op8 = [](__m256 a, __m256 b) { return kMax ? _mm256_max_ps(a, b) : _mm256_min_ps(a, b); };
   auto op4 = [](__m128 a, __m128 b) { return kMax ? _mm_max_ps(a, b) : _mm_min_ps(a, b); };
-  const __m256 h =
-      op8(_mm512_maskz_extractf32x8_ps(0xff, v, 0), _mm512_maskz_extractf32x8_ps(0xff, v, 1));
+  const __m256 h = op8(_mm512_castps512_ps256(v), _mm512_extractf32x8_ps(v, 1));
   __m128 q = op4(_mm256_castps256_ps128(h), _mm256_extractf128_ps(h, 1));
   q = op4(q, _mm_movehl_ps(q, q));
   q = op4(q, _mm_shuffle_ps(q, q, 1));
@@ -118,16 +100,16 @@ bool BoundsOfRun(const float* const row[3], uint32_t first, uint32_t last, float
   for (; i + 15 <= last; i += 16)
     for (int a = 0; a < 3; ++a) {
       const __m512 q = _mm512_loadu_ps(row[a] + i);
-      vlo[a] = Min(vlo[a], q);
-      vhi[a] = Max(vhi[a], q);
+      vlo[a] = _mm512_min_ps(vlo[a], q);
+      vhi[a] = _mm512_max_ps(vhi[a], q);
     }
   if (i <= last) {
     // The tail's other lanes read as +inf for the minimum, -inf for the
     // maximum; a masked load touches no memory outside its mask.
     const auto tail = static_cast<__mmask16>((1u << (last + 1 - i)) - 1);
     for (int a = 0; a < 3; ++a) {
-      vlo[a] = Min(vlo[a], _mm512_mask_loadu_ps(inf, tail, row[a] + i));
-      vhi[a] = Max(vhi[a], _mm512_mask_loadu_ps(minus_inf, tail, row[a] + i));
+      vlo[a] = _mm512_min_ps(vlo[a], _mm512_mask_loadu_ps(inf, tail, row[a] + i));
+      vhi[a] = _mm512_max_ps(vhi[a], _mm512_mask_loadu_ps(minus_inf, tail, row[a] + i));
     }
   }
   for (int a = 0; a < 3; ++a) {

@@ -18,8 +18,8 @@ bool Bit(const std::vector<uint64_t>& bits, uint32_t i) { return (bits[i / 64] >
 // ties included (the SIMD path may not round or compare differently).
 // Each instruction set's row pass, checked on its own against the scalar
 // predicate: core/filter/link_row_masks.cpp (SSE2) and
-// core/filter/link_row_masks_avx2.cpp and link_row_masks_avx512.cpp (only
-// where the CPU has them).
+// core/filter/link_row_masks_avx2.cpp and
+// core/filter/link_row_masks_avx512.cpp (only where the CPU has them).
 class LinkRowMasks : public ::testing::TestWithParam<RowIsa> {
  protected:
   void SetUp() override {
