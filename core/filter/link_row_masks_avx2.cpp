@@ -2,69 +2,44 @@
 
 #include <immintrin.h>
 
+#include "core/filter/link_row_pass.h"
+
 namespace surfinspect::link_row::avx2 {
 namespace {
 
-// 8 link tests at once: PointsLinked's float operations in its order.
-inline uint64_t Link8(__m256 px, __m256 py, __m256 pz, const float* bx, const float* by,
-                      const float* bz, __m256 r2) {
-  const __m256 dx = _mm256_sub_ps(px, _mm256_loadu_ps(bx));
-  const __m256 dy = _mm256_sub_ps(py, _mm256_loadu_ps(by));
-  const __m256 dz = _mm256_sub_ps(pz, _mm256_loadu_ps(bz));
-  const __m256 d2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
-                                  _mm256_mul_ps(dz, dz));
+// The row pass's operations on 8 floats.
+struct Avx2 {
+  using Vec = __m256;
+  static constexpr int kWidth = 8;
+  static Vec Load(const float* p) { return _mm256_loadu_ps(p); }
+  static Vec Set1(float v) { return _mm256_set1_ps(v); }
+  static Vec Sub(Vec a, Vec b) { return _mm256_sub_ps(a, b); }
+  static Vec Mul(Vec a, Vec b) { return _mm256_mul_ps(a, b); }
+  static Vec Add(Vec a, Vec b) { return _mm256_add_ps(a, b); }
   // Ordered <=, as SSE2's cmpleps: NaN never links.
-  return static_cast<uint64_t>(_mm256_movemask_ps(_mm256_cmp_ps(d2, r2, _CMP_LE_OQ)));
-}
-
-template <bool kAbove, bool kDiagonals>
-bool Pass(const float* const cur[3], const float* const up[3], uint32_t words, float r2,
-          uint64_t* const masks[5]) {
-  const float *x = cur[0], *y = cur[1], *z = cur[2];
-  const float *ux = up[0], *uy = up[1], *uz = up[2];
-  const __m256 zero = _mm256_setzero_ps(), inf = _mm256_set1_ps(__builtin_inff()),
-               r = _mm256_set1_ps(r2);
-  const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
-  __m256 any_inf = zero;
-  for (uint32_t k = 0; k < words; ++k) {
-    uint64_t valid = 0, west = 0, north_west = 0, north = 0, north_east = 0;
-    for (uint32_t j = 0; j < 64; j += 8) {
-      const uint32_t i = 64 * k + j;
-      const __m256 px = _mm256_loadu_ps(x + i), py = _mm256_loadu_ps(y + i),
-                   pz = _mm256_loadu_ps(z + i);
-      // 0 * NaN and 0 * inf are NaN: the sum is 0 only for a valid pixel.
-      const __m256 s = _mm256_add_ps(
-          _mm256_add_ps(_mm256_mul_ps(px, zero), _mm256_mul_ps(py, zero)), _mm256_mul_ps(pz, zero));
-      const uint64_t valid8 = uint64_t(_mm256_movemask_ps(_mm256_cmp_ps(s, zero, _CMP_EQ_OQ)));
-      valid |= valid8 << j;
-      any_inf = _mm256_or_ps(
-          any_inf, _mm256_or_ps(_mm256_cmp_ps(_mm256_and_ps(px, abs_mask), inf, _CMP_EQ_OQ),
-                                _mm256_cmp_ps(_mm256_and_ps(py, abs_mask), inf, _CMP_EQ_OQ)));
-      any_inf = _mm256_or_ps(any_inf, _mm256_cmp_ps(_mm256_and_ps(pz, abs_mask), inf, _CMP_EQ_OQ));
-      // A pixel without data links to nothing: eight of them in a row (a
-      // shadow, the background) skip the link tests, which are the pass's
-      // float work.
-      if (valid8 == 0) continue;
-      west |= Link8(px, py, pz, x + i - 1, y + i - 1, z + i - 1, r) << j;
-      if (kAbove) north |= Link8(px, py, pz, ux + i, uy + i, uz + i, r) << j;
-      if (kDiagonals) {
-        north_west |= Link8(px, py, pz, ux + i - 1, uy + i - 1, uz + i - 1, r) << j;
-        north_east |= Link8(px, py, pz, ux + i + 1, uy + i + 1, uz + i + 1, r) << j;
-      }
-    }
-    masks[0][k] = valid, masks[1][k] = west;
-    masks[2][k] = north_west, masks[3][k] = north, masks[4][k] = north_east;
+  static uint64_t LessEqual(Vec a, Vec b) {
+    return static_cast<uint64_t>(_mm256_movemask_ps(_mm256_cmp_ps(a, b, _CMP_LE_OQ)));
   }
-  return _mm256_movemask_ps(any_inf) != 0;
-}
+  // 0 * NaN and 0 * inf are NaN: the sum is 0 only for a valid pixel.
+  static uint64_t NotFinite(Vec x, Vec y, Vec z) {
+    const Vec zero = _mm256_setzero_ps();
+    const Vec s = Add(Add(Mul(x, zero), Mul(y, zero)), Mul(z, zero));
+    return static_cast<uint64_t>(_mm256_movemask_ps(_mm256_cmp_ps(s, zero, _CMP_NEQ_UQ)));
+  }
+  static uint64_t Infinite(Vec x, Vec y, Vec z) {
+    const Vec abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+    const Vec inf = _mm256_set1_ps(__builtin_inff());
+    auto is_inf = [&](Vec v) { return _mm256_cmp_ps(_mm256_and_ps(v, abs_mask), inf, _CMP_EQ_OQ); };
+    return static_cast<uint64_t>(
+        _mm256_movemask_ps(_mm256_or_ps(_mm256_or_ps(is_inf(x), is_inf(y)), is_inf(z))));
+  }
+};
 
 }  // namespace
 
 bool RowBits(const float* const cur[3], const float* const up[3], bool diagonals, uint32_t words,
              float link_distance_sq, uint64_t* const masks[5]) {
-  if (!up) return Pass<false, false>(cur, cur, words, link_distance_sq, masks);
-  if (diagonals) return Pass<true, true>(cur, up, words, link_distance_sq, masks);
-  return Pass<true, false>(cur, up, words, link_distance_sq, masks);
+  return RowBitsOf<Avx2>(cur, up, diagonals, words, link_distance_sq, masks);
 }
 
 void Transpose(const float* f, uint32_t w, float* x, float* y, float* z) {

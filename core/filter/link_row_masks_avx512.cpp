@@ -2,69 +2,49 @@
 
 #include <immintrin.h>
 
+#include "core/filter/link_row_pass.h"
 #include "core/types/transpose16_avx512.h"
 
 namespace surfinspect::link_row::avx512 {
 namespace {
 
-// 16 link tests at once: PointsLinked's float operations in its order
-// (no FMA: the file is built with -ffp-contract=off), an ordered <= as
-// SSE2's cmpleps, so NaN never links.
-inline uint64_t Link16(__m512 px, __m512 py, __m512 pz, const float* bx, const float* by,
-                       const float* bz, __m512 r2) {
-  const __m512 dx = _mm512_sub_ps(px, _mm512_loadu_ps(bx));
-  const __m512 dy = _mm512_sub_ps(py, _mm512_loadu_ps(by));
-  const __m512 dz = _mm512_sub_ps(pz, _mm512_loadu_ps(bz));
-  const __m512 d2 = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)),
-                                  _mm512_mul_ps(dz, dz));
-  return _mm512_cmp_ps_mask(d2, r2, _CMP_LE_OQ);
-}
-
-using surfinspect::avx512::kInfinite;
-using surfinspect::avx512::NotFinite;
-
-template <bool kAbove, bool kDiagonals>
-bool Pass(const float* const cur[3], const float* const up[3], uint32_t words, float r2,
-          uint64_t* const masks[5]) {
-  const float *x = cur[0], *y = cur[1], *z = cur[2];
-  const float *ux = up[0], *uy = up[1], *uz = up[2];
-  const __m512 r = _mm512_set1_ps(r2);
-  __mmask16 any_inf = 0;
-  for (uint32_t k = 0; k < words; ++k) {
-    uint64_t valid = 0, west = 0, north_west = 0, north = 0, north_east = 0;
-    for (uint32_t j = 0; j < 64; j += 16) {
-      const uint32_t i = 64 * k + j;
-      const __m512 px = _mm512_loadu_ps(x + i), py = _mm512_loadu_ps(y + i),
-                   pz = _mm512_loadu_ps(z + i);
-      // Valid: every coordinate finite, which is what the other passes'
-      // x * 0 + y * 0 + z * 0 == 0 tests.
-      const __mmask16 bad = NotFinite(px, py, pz);
-      if (bad != 0) {
-        any_inf |= _mm512_fpclass_ps_mask(px, kInfinite) | _mm512_fpclass_ps_mask(py, kInfinite) |
-                   _mm512_fpclass_ps_mask(pz, kInfinite);
-        if (bad == 0xffff) continue;  // no data links to nothing (as in the AVX2 pass)
-      }
-      valid |= uint64_t{static_cast<uint16_t>(~bad)} << j;
-      west |= Link16(px, py, pz, x + i - 1, y + i - 1, z + i - 1, r) << j;
-      if (kAbove) north |= Link16(px, py, pz, ux + i, uy + i, uz + i, r) << j;
-      if (kDiagonals) {
-        north_west |= Link16(px, py, pz, ux + i - 1, uy + i - 1, uz + i - 1, r) << j;
-        north_east |= Link16(px, py, pz, ux + i + 1, uy + i + 1, uz + i + 1, r) << j;
-      }
-    }
-    masks[0][k] = valid, masks[1][k] = west;
-    masks[2][k] = north_west, masks[3][k] = north, masks[4][k] = north_east;
+// The row pass's operations on 16 floats, compared into mask registers.
+struct Avx512 {
+  using Vec = __m512;
+  static constexpr int kWidth = 16;
+  static Vec Load(const float* p) { return _mm512_loadu_ps(p); }
+  static Vec Set1(float v) { return _mm512_set1_ps(v); }
+  static Vec Sub(Vec a, Vec b) { return _mm512_sub_ps(a, b); }
+  static Vec Mul(Vec a, Vec b) { return _mm512_mul_ps(a, b); }
+  static Vec Add(Vec a, Vec b) { return _mm512_add_ps(a, b); }
+  // Ordered <=, as SSE2's cmpleps: NaN never links.
+  static uint64_t LessEqual(Vec a, Vec b) { return _mm512_cmp_ps_mask(a, b, _CMP_LE_OQ); }
+  // vfpclassps: what the other sets' x * 0 + y * 0 + z * 0 != 0 tests.
+  static uint64_t NotFinite(Vec x, Vec y, Vec z) { return surfinspect::avx512::NotFinite(x, y, z); }
+  static uint64_t Infinite(Vec x, Vec y, Vec z) {
+    using surfinspect::avx512::kInfinite;
+    return _mm512_fpclass_ps_mask(x, kInfinite) | _mm512_fpclass_ps_mask(y, kInfinite) |
+           _mm512_fpclass_ps_mask(z, kInfinite);
   }
-  return any_inf != 0;
+};
+
+// The least (kMax: greatest) of the 16 lanes, by halving.
+template <bool kMax>
+float Reduce(__m512 v) {
+  auto op8 = [](__m256 a, __m256 b) { return kMax ? _mm256_max_ps(a, b) : _mm256_min_ps(a, b); };
+  auto op4 = [](__m128 a, __m128 b) { return kMax ? _mm_max_ps(a, b) : _mm_min_ps(a, b); };
+  const __m256 h = op8(_mm512_castps512_ps256(v), _mm512_extractf32x8_ps(v, 1));
+  __m128 q = op4(_mm256_castps256_ps128(h), _mm256_extractf128_ps(h, 1));
+  q = op4(q, _mm_movehl_ps(q, q));
+  q = op4(q, _mm_shuffle_ps(q, q, 1));
+  return _mm_cvtss_f32(q);
 }
 
 }  // namespace
 
 bool RowBits(const float* const cur[3], const float* const up[3], bool diagonals, uint32_t words,
              float link_distance_sq, uint64_t* const masks[5]) {
-  if (!up) return Pass<false, false>(cur, cur, words, link_distance_sq, masks);
-  if (diagonals) return Pass<true, true>(cur, up, words, link_distance_sq, masks);
-  return Pass<true, false>(cur, up, words, link_distance_sq, masks);
+  return RowBitsOf<Avx512>(cur, up, diagonals, words, link_distance_sq, masks);
 }
 
 void Transpose(const float* f, uint32_t w, float* x, float* y, float* z) {
@@ -77,18 +57,6 @@ void Transpose(const float* f, uint32_t w, float* x, float* y, float* z) {
     _mm512_storeu_ps(z + i, pz);
   }
   for (; i < w; ++i, f += 3) x[i] = f[0], y[i] = f[1], z[i] = f[2];
-}
-
-// The least (kMax: greatest) of the 16 lanes, by halving.
-template <bool kMax>
-float Reduce(__m512 v) {
-  auto op8 = [](__m256 a, __m256 b) { return kMax ? _mm256_max_ps(a, b) : _mm256_min_ps(a, b); };
-  auto op4 = [](__m128 a, __m128 b) { return kMax ? _mm_max_ps(a, b) : _mm_min_ps(a, b); };
-  const __m256 h = op8(_mm512_castps512_ps256(v), _mm512_extractf32x8_ps(v, 1));
-  __m128 q = op4(_mm256_castps256_ps128(h), _mm256_extractf128_ps(h, 1));
-  q = op4(q, _mm_movehl_ps(q, q));
-  q = op4(q, _mm_shuffle_ps(q, q, 1));
-  return _mm_cvtss_f32(q);
 }
 
 bool BoundsOfRun(const float* const row[3], uint32_t first, uint32_t last, float lo[3],
