@@ -22,13 +22,15 @@ using link_row::RowSoA;
 // union-find.
 struct GridScratch {
   GridScratch(uint32_t width, uint32_t height)
-      : words((width + 63) / 64),
+      : isa(link_row::ResolveRowIsa(link_row::RowIsa::kAuto)),
+        words((width + 63) / 64),
         rows{RowSoA(64 * words), RowSoA(64 * words)},
         masks(7 * std::size_t{words}) {
     // The demo scan has about 30 runs a row; the reserve avoids regrowing.
     runs.reserve(32 * std::size_t{height});
     forest.Reserve(32 * std::size_t{height});
   }
+  const link_row::RowIsa isa;  // the row kernels' set, resolved once per band
   const uint32_t words;
   RowSoA rows[2];
   // Masks: valid, west, north-west, north, north-east, run starts, run ends.
@@ -101,8 +103,8 @@ absl::Status LabelRow(const PointCloud& cloud, uint32_t r, uint32_t band_first, 
   const uint32_t w = cloud.width, h = cloud.height;
   RowSoA& cur = g.rows[r & 1];
   const RowSoA& up = g.rows[(r + 1) & 1];
-  link_row::Transpose(&cloud.points[std::size_t{r} * w], w, cur);
-  if (r + 1 < h && link_row::ResolveRowIsa(link_row::RowIsa::kAuto) != link_row::RowIsa::kAvx512) {
+  link_row::Transpose(&cloud.points[std::size_t{r} * w], w, cur, g.isa);
+  if (r + 1 < h && g.isa != link_row::RowIsa::kAvx512) {
     // The next row streams in while this one is labelled: without it the
     // transpose is bound by load latency on an AMD EPYC (AVX2, measured).
     // On an Intel Xeon with AVX-512 the hardware prefetcher keeps up, and
@@ -112,7 +114,7 @@ absl::Status LabelRow(const PointCloud& cloud, uint32_t r, uint32_t band_first, 
       __builtin_prefetch(next + b);
   }
   const bool above = r > 0;
-  if (link_row::ComputeMasks(cur, above ? &up : nullptr, eight, g.words, r2, g.m()))
+  if (link_row::ComputeMasks(cur, above ? &up : nullptr, eight, g.words, r2, g.m(), g.isa))
     return absl::InvalidArgumentError(
         absl::StrCat("link clustering: row ", r, " holds an infinite coordinate"));
   const RowMasks m = g.m();
@@ -132,7 +134,7 @@ absl::Status LabelRow(const PointCloud& cloud, uint32_t r, uint32_t band_first, 
     // failed store forwarding per run (measured).
     Run& run = g.runs.emplace_back();
     run.row = r, run.first_col = s, run.last_col = e;
-    link_row::Bounds(cur, s, e, run.lo, run.hi);
+    link_row::Bounds(cur, s, e, run.lo, run.hi, g.isa);
     if (merge) MergeWithRunsAbove(vertical, id, s, e, w, eight, row_above, g.forest);
   }
   return absl::OkStatus();
@@ -147,7 +149,7 @@ void LabelBand(const PointCloud& cloud, float r2, bool eight, const std::atomic<
   // The row above the band, for the first row's vertical masks.
   if (band.first > 0)
     link_row::Transpose(&cloud.points[std::size_t{band.first - 1} * cloud.width], cloud.width,
-                        g.rows[(band.first - 1) & 1]);
+                        g.rows[(band.first - 1) & 1], g.isa);
   for (uint32_t r = band.first; r < band.end; ++r) {
     if (IsCancelled(cancel)) {
       band.status = absl::CancelledError("link clustering: cancelled");

@@ -25,10 +25,13 @@ void Transpose(const Eigen::Vector3f* pts, uint32_t w, RowSoA& row, RowIsa isa) 
   float* __restrict y = row.c(1);
   float* __restrict z = row.c(2);
   const float* f = pts[0].data();
-  isa = ResolveRowIsa(isa);
-  if (isa == RowIsa::kAvx512) return avx512::Transpose(f, w, x, y, z);
-  if (isa == RowIsa::kAvx2) return avx2::Transpose(f, w, x, y, z);
+  // The wider sets take whole groups of 8 or 16 points; SSE2 and the scalar
+  // loop finish the row.
   uint32_t i = 0;
+  isa = ResolveRowIsa(isa);
+  if (isa == RowIsa::kAvx512) i = avx512::Transpose(f, w, x, y, z);
+  if (isa == RowIsa::kAvx2) i = avx2::Transpose(f, w, x, y, z);
+  f += 3 * std::size_t{i};
 #if defined(__SSE2__)
   for (; i + 4 <= w; i += 4, f += 12) {
     const __m128 a = _mm_loadu_ps(f), b = _mm_loadu_ps(f + 4), c = _mm_loadu_ps(f + 8);

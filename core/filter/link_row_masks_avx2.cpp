@@ -42,7 +42,7 @@ bool RowBits(const float* const cur[3], const float* const up[3], bool diagonals
   return RowBitsOf<Avx2>(cur, up, diagonals, words, link_distance_sq, masks);
 }
 
-void Transpose(const float* f, uint32_t w, float* x, float* y, float* z) {
+uint32_t Transpose(const float* f, uint32_t w, float* x, float* y, float* z) {
   uint32_t i = 0;
   for (; i + 8 <= w; i += 8, f += 24) {
     // Lanes 0-3 hold points 0-3 and lanes 4-7 points 4-7, so each 128-bit
@@ -59,7 +59,7 @@ void Transpose(const float* f, uint32_t w, float* x, float* y, float* z) {
     _mm256_storeu_ps(y + i, _mm256_shuffle_ps(yz, xy, _MM_SHUFFLE(3, 1, 2, 0)));
     _mm256_storeu_ps(z + i, _mm256_shuffle_ps(yz, c, _MM_SHUFFLE(3, 0, 3, 1)));
   }
-  for (; i < w; ++i, f += 3) x[i] = f[0], y[i] = f[1], z[i] = f[2];
+  return i;
 }
 
 }  // namespace surfinspect::link_row::avx2

@@ -16,8 +16,10 @@ namespace surfinspect::link_row::avx2 {
 bool RowBits(const float* const cur[3], const float* const up[3], bool diagonals, uint32_t words,
              float link_distance_sq, uint64_t* const masks[5]);
 
-// w points (x, y, z interleaved in `points`) into the planes x, y, z: 8
-// points per 3 loads, 5 shuffles and 3 stores. Call only where AVX2 runs.
-void Transpose(const float* points, uint32_t w, float* x, float* y, float* z);
+// The first of w points (x, y, z interleaved in `points`) into the planes
+// x, y, z, in whole groups of 8 (3 loads, 5 shuffles and 3 stores each);
+// returns how many it took (w rounded down to a multiple of 8). Call only
+// where AVX2 runs.
+uint32_t Transpose(const float* points, uint32_t w, float* x, float* y, float* z);
 
 }  // namespace surfinspect::link_row::avx2

@@ -47,7 +47,7 @@ bool RowBits(const float* const cur[3], const float* const up[3], bool diagonals
   return RowBitsOf<Avx512>(cur, up, diagonals, words, link_distance_sq, masks);
 }
 
-void Transpose(const float* f, uint32_t w, float* x, float* y, float* z) {
+uint32_t Transpose(const float* f, uint32_t w, float* x, float* y, float* z) {
   uint32_t i = 0;
   for (; i + 16 <= w; i += 16, f += 48) {
     __m512 px, py, pz;
@@ -56,7 +56,7 @@ void Transpose(const float* f, uint32_t w, float* x, float* y, float* z) {
     _mm512_storeu_ps(y + i, py);
     _mm512_storeu_ps(z + i, pz);
   }
-  for (; i < w; ++i, f += 3) x[i] = f[0], y[i] = f[1], z[i] = f[2];
+  return i;
 }
 
 bool BoundsOfRun(const float* const row[3], uint32_t first, uint32_t last, float lo[3],

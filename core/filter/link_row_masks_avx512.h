@@ -13,9 +13,9 @@ namespace surfinspect::link_row::avx512 {
 bool RowBits(const float* const cur[3], const float* const up[3], bool diagonals, uint32_t words,
              float link_distance_sq, uint64_t* const masks[5]);
 
-// As avx2::Transpose: 16 points per 3 loads, 6 permutes and 3 stores. Call
-// only where AVX-512F runs.
-void Transpose(const float* points, uint32_t w, float* x, float* y, float* z);
+// As avx2::Transpose, in whole groups of 16 points (3 loads, 6 permutes
+// and 3 stores each). Call only where AVX-512F runs.
+uint32_t Transpose(const float* points, uint32_t w, float* x, float* y, float* z);
 
 // Bounds of the pixels first..last of the planes (all valid), 16 at a
 // time. Returns false, leaving the caller to its 4-lane reduction, where a
