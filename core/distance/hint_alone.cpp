@@ -135,8 +135,15 @@ HintRise ComputeHintRise(const TriangleMesh& mesh, const std::vector<uint32_t>& 
 }
 
 bool RingIsFarther(const HintRise& rise, const Eigen::Vector3d& p, const Eigen::Vector3d& q,
-                   double d, const Eigen::Vector3d& n, const Eigen::Vector3d a[3]) {
+                   double d, const Eigen::Vector3d& n, const TriangleMesh& mesh, uint32_t t) {
   if (!rise.valid) return false;
+  // The corners are widened here, not by the caller: a caller's array of
+  // doubles, written one coordinate at a time and read here two at a time,
+  // stalls every load on a failed store forward.
+  const Triangle& tri = mesh.triangles[t];
+  const Eigen::Vector3d a[3] = {mesh.vertices[tri[0]].cast<double>(),
+                                mesh.vertices[tri[1]].cast<double>(),
+                                mesh.vertices[tri[2]].cast<double>()};
   const int side = n.dot(p - a[0]) >= 0 ? 0 : 1;
   const double longest = rise.longest_edge_mm;
   const double scale = p.cwiseAbs().maxCoeff() + longest + d;

@@ -52,8 +52,8 @@ HintRise ComputeHintRise(const TriangleMesh& mesh, const std::vector<uint32_t>& 
 
 // True when no triangle of t's ring is as close to p as t, given the
 // kernel's answer on t: closest point q inside the face (feature kFace) at
-// distance d; `a` are t's vertices and `n` its unit normal, as above.
+// distance d; `n` is t's unit normal, as above.
 bool RingIsFarther(const HintRise& rise, const Eigen::Vector3d& p, const Eigen::Vector3d& q,
-                   double d, const Eigen::Vector3d& n, const Eigen::Vector3d a[3]);
+                   double d, const Eigen::Vector3d& n, const TriangleMesh& mesh, uint32_t t);
 
 }  // namespace surfinspect

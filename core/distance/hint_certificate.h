@@ -40,18 +40,21 @@
 
 namespace surfinspect {
 
+// The fields in the order a query reads them: a walk reads the first 40
+// bytes of each triangle it passes, a proof by the hint alone the next 36,
+// a ring's lanes the rest.
 struct HintCertificate {
   static constexpr int kMaxBlocks = 6;
-  double anchor[3] = {};            // m, mm, mesh frame
-  float reach_mm = 0;               // D, rounded down; 0 never certifies
+  double anchor[3] = {};  // m, mm, mesh frame
+  float reach_mm = 0;     // D, rounded down; 0 never certifies
+  // The triangle across edge AB, BC, CA when exactly one other shares it,
+  // else UINT32_MAX: where a query whose closest point lies beyond that
+  // edge looks next.
+  uint32_t across[3] = {UINT32_MAX, UINT32_MAX, UINT32_MAX};
+  HintRise rise;                    // when the hint alone is provably the answer (hint_alone.h)
   uint32_t block[kMaxBlocks] = {};  // the leaf blocks holding the ring
   uint8_t lanes[kMaxBlocks] = {};   // the ring's lanes in each block
   uint8_t blocks = 0;               // entries in use
-  HintRise rise;                    // when the hint alone is provably the answer (hint_alone.h)
-  // The triangle across edge AB, BC, CA when exactly one other shares it,
-  // else UINT32_MAX: where a query whose closest point lies on that edge
-  // looks next.
-  uint32_t across[3] = {UINT32_MAX, UINT32_MAX, UINT32_MAX};
 
   // True when p is within `reaches` times the reach of the anchor: a cheap
   // test of whether a step or two across the mesh could end in a proof.

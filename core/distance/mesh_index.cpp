@@ -12,6 +12,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/distance/embree_handles.h"
 #include "core/distance/hint_certificate.h"
+#include "core/distance/mesh_order.h"
 #include "core/distance/wide_bvh.h"
 
 namespace surfinspect {
@@ -22,6 +23,7 @@ struct QueryState {
   const Eigen::Vector3f* vertices;
   const Triangle* triangles;
   const TriangleShape* shapes;
+  const uint32_t* mesh_triangle;  // ties go to the lower mesh id, not position
   double coordinate_scale;
   uint32_t best_triangle = UINT32_MAX;
   PointTriangleResult best;
@@ -50,7 +52,8 @@ bool Consider(wide::Query& q, QueryState& s, uint32_t t, const PointTriangleResu
   const bool better = s.best_triangle == UINT32_MAX
                           ? r.squared_distance <= q.best_d2
                           : r.squared_distance < q.best_d2 ||
-                                (r.squared_distance == q.best_d2 && t < s.best_triangle);
+                                (r.squared_distance == q.best_d2 &&
+                                 s.mesh_triangle[t] < s.mesh_triangle[s.best_triangle]);
   if (!better) return false;
   s.best = r;
   s.best_triangle = t;
@@ -89,6 +92,8 @@ bool OfferTriangle(wide::Query& q, uint32_t t) {
 // Steps across the edge or corner the best closest point lies on, at most this many
 // times: the scan points' hints are mostly one triangle off.
 constexpr int kMaxSteps = 2;
+// Steps of the walk by edge lines that come before them.
+constexpr int kMaxWalk = 3;
 
 }  // namespace
 
@@ -115,14 +120,26 @@ absl::StatusOr<std::unique_ptr<MeshIndex>> MeshIndex::Build(TriangleMesh mesh,
   absl::StatusOr<WideBvh> bvh;
   arena.execute([&] {
     try {
-      // The edge and vertex pseudonormals are serial work: they run beside
+      // The BVH and the certificates are built on the spatial order; the
+      // edge and vertex pseudonormals on the mesh's, so that their sums
+      // add in the mesh's order. They are serial work: they run beside
       // Embree's parallel build instead of before it.
+      MeshOrder order = OrderMesh(index->mesh_);
+      std::vector<Eigen::Vector3d> ordered_normal(order.mesh_triangle.size());
+      std::vector<TriangleShape> ordered_shape(order.mesh_triangle.size());
+      for (std::size_t i = 0; i < order.mesh_triangle.size(); ++i) {
+        ordered_normal[i] = index->face_normal_[order.mesh_triangle[i]];
+        ordered_shape[i] = index->shape_[order.mesh_triangle[i]];
+      }
       tbb::parallel_invoke(
           [&] {
-            bvh = WideBvh::Build((*device)->get(), index->mesh_, index->face_normal_, index->shape_,
+            bvh = WideBvh::Build((*device)->get(), order.ordered, ordered_normal, ordered_shape,
                                  EmbreeBuildQuality(settings.build_quality), settings.search_isa);
           },
           [&] { index->ComputeFeatureNormals(); });
+      index->face_normal_ = std::move(ordered_normal);
+      index->shape_ = std::move(ordered_shape);
+      index->ApplyOrder(std::move(order));
     } catch (const std::bad_alloc&) {
       bvh = absl::ResourceExhaustedError(
           absl::StrCat("mesh index: out of memory building the index of ",
@@ -139,8 +156,8 @@ absl::StatusOr<std::unique_ptr<MeshIndex>> MeshIndex::Build(TriangleMesh mesh,
     bool out_of_memory = false;
     arena.execute([&] {
       try {
-        index->certificates_ = std::make_unique<HintCertificates>(
-            HintCertificates::Build(index->mesh_, index->weld_, index->face_normal_, *index->bvh_));
+        index->certificates_ = std::make_unique<HintCertificates>(HintCertificates::Build(
+            index->ordered_, index->weld_, index->face_normal_, *index->bvh_));
       } catch (const std::bad_alloc&) {
         out_of_memory = true;
       }
@@ -185,10 +202,31 @@ void MeshIndex::ComputeFaceNormals() {
   }
 }
 
+// Moves the per-triangle and per-vertex data, computed in the mesh's
+// order, to the spatial order's positions; the values are unchanged.
+void MeshIndex::ApplyOrder(MeshOrder order) {
+  std::vector<std::array<uint32_t, 3>> edges(triangle_edges_.size());
+  for (std::size_t i = 0; i < edges.size(); ++i) edges[i] = triangle_edges_[order.mesh_triangle[i]];
+  triangle_edges_ = std::move(edges);
+  // A vertex's representative keeps its role under its new position.
+  std::vector<uint32_t> weld(weld_.size());
+  std::vector<Eigen::Vector3d> vertex_normal(vertex_normal_.size());
+  for (std::size_t v = 0; v < weld_.size(); ++v) {
+    const uint32_t at = order.position_of_vertex[v];
+    weld[at] = order.position_of_vertex[weld_[v]];
+    vertex_normal[at] = vertex_normal_[v];
+  }
+  weld_ = std::move(weld);
+  vertex_normal_ = std::move(vertex_normal);
+  ordered_ = std::move(order.ordered);
+  mesh_triangle_ = std::move(order.mesh_triangle);
+  position_of_triangle_ = std::move(order.position_of_triangle);
+}
+
 const Eigen::Vector3d& MeshIndex::Pseudonormal(uint32_t triangle, ClosestFeature feature) const {
   const int k = FeatureIndex(feature);
   if (IsEdge(feature)) return edge_normal_[triangle_edges_[triangle][k]];
-  if (IsVertex(feature)) return vertex_normal_[weld_[mesh_.triangles[triangle][k]]];
+  if (IsVertex(feature)) return vertex_normal_[weld_[ordered_.triangles[triangle][k]]];
   return face_normal_[triangle];
 }
 
@@ -199,9 +237,10 @@ ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_dis
   if (path) *path = QueryPath::kTree;
   if (!p_in_mesh.allFinite() || !(max_distance_mm >= 0)) return out;
   QueryState s{p_in_mesh,
-               mesh_.vertices.data(),
-               mesh_.triangles.data(),
+               ordered_.vertices.data(),
+               ordered_.triangles.data(),
                shape_.data(),
+               mesh_triangle_.data(),
                p_in_mesh.cwiseAbs().maxCoeff(),
                UINT32_MAX,
                {}};
@@ -215,10 +254,14 @@ ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_dis
                 &OfferLane};
   // Beyond float range the boxes cannot place the point; such a point is unmatched.
   if (!std::isfinite(q.pf[0]) || !std::isfinite(q.pf[1]) || !std::isfinite(q.pf[2])) return out;
-  // A good first candidate (the previous point's triangle) starts the
-  // search with a nearly exact radius; the result is the same without it.
-  if (hint_triangle < mesh_.num_triangles()) OfferTriangle(q, hint_triangle);
-  const QueryPath taken = try_certificate ? CertifiedByHint(q, hint_triangle) : QueryPath::kTree;
+  // A good first candidate (the previous point's triangle, or where a walk
+  // from it ends) starts the search with a nearly exact radius; the result
+  // is the same without it.
+  const bool hinted = hint_triangle < mesh_.num_triangles();
+  const uint32_t hint = hinted ? position_of_triangle_[hint_triangle] : UINT32_MAX;
+  const QueryPath taken =
+      hinted && try_certificate && certificates_ ? CertifiedByHint(q, hint) : QueryPath::kTree;
+  if (hinted && s.best_triangle == UINT32_MAX) OfferTriangle(q, hint);
   if (taken == QueryPath::kTree) {
     PrepareSearch(q, s, max_distance_mm);
     bvh_->Search(q);
@@ -227,7 +270,7 @@ ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_dis
   if (s.best_triangle == UINT32_MAX) return out;
 
   const uint32_t t = s.best_triangle;
-  out.triangle_id = t;
+  out.triangle_id = mesh_triangle_[t];
   out.point = s.best.point;
   out.feature = s.best.feature;
   out.distance_mm = std::sqrt(s.best.squared_distance);
@@ -247,11 +290,12 @@ ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_dis
 // (core/distance/hint_certificate.h); kTree otherwise.
 QueryPath MeshIndex::CertifiedByHint(wide::Query& q, uint32_t hint_triangle) const {
   const auto& s = *static_cast<const QueryState*>(q.context);
-  if (!certificates_ || s.best_triangle != hint_triangle || hint_triangle == UINT32_MAX)
-    return QueryPath::kTree;
   // Two steps move the anchor by about a triangle: a point farther than
   // twice the hint's reach from its anchor would not certify after them.
   if (!certificates_->of(hint_triangle).Near(s.p, 2)) return QueryPath::kTree;
+  // Most hints are a triangle off: walking by the edge lines costs less
+  // than the kernel on each triangle passed.
+  if (!OfferTriangle(q, WalkTowards(hint_triangle, s.p))) return QueryPath::kTree;
   for (int step = 0; step < kMaxSteps && s.best.feature != ClosestFeature::kFace; ++step) {
     // Across the closest edge, or across both edges at the closest corner.
     const HintCertificate& at = certificates_->of(s.best_triangle);
@@ -268,22 +312,62 @@ QueryPath MeshIndex::CertifiedByHint(wide::Query& q, uint32_t hint_triangle) con
   const HintCertificate& c = certificates_->of(t);
   const double d = std::sqrt(q.best_d2);
   if (!c.Certifies(s.p, d, s.coordinate_scale)) return QueryPath::kTree;
-  if (s.best.feature == ClosestFeature::kFace) {
-    const Triangle& tri = mesh_.triangles[t];
-    const Eigen::Vector3d a[3] = {mesh_.vertices[tri[0]].cast<double>(),
-                                  mesh_.vertices[tri[1]].cast<double>(),
-                                  mesh_.vertices[tri[2]].cast<double>()};
-    if (RingIsFarther(c.rise, s.p, s.best.point, d, face_normal_[t], a))
-      return QueryPath::kHintAlone;
-  }
+  if (s.best.feature == ClosestFeature::kFace &&
+      RingIsFarther(c.rise, s.p, s.best.point, d, face_normal_[t], ordered_, t))
+    return QueryPath::kHintAlone;
   PrepareSearch(q, s, INFINITY);
   for (int j = 0; j < c.blocks; ++j) bvh_->VisitLanes(c.block[j], c.lanes[j], q);
   return QueryPath::kRing;
 }
 
+// The edge line of triangle t that p lies beyond, in t's plane: k for edge
+// a_k a_k+1, whose outward normal m_k = (a_k+1 - a_k) x n has
+// m_k . (p - a_k) > 0 there; where two are, the one p is farther beyond (in
+// the edge's length), so each step crosses one edge. -1 when p lies over
+// the face, and for a degenerate face (n = 0).
+int MeshIndex::EdgeBeyond(uint32_t t, const Eigen::Vector3d& p) const {
+  const Triangle& tri = ordered_.triangles[t];
+  const Eigen::Vector3d& n = face_normal_[t];
+  const Eigen::Vector3d a[3] = {ordered_.vertices[tri[0]].cast<double>(),
+                                ordered_.vertices[tri[1]].cast<double>(),
+                                ordered_.vertices[tri[2]].cast<double>()};
+  int best = -1;
+  double best_excess2 = 0, best_len2 = 1;
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector3d e = a[(k + 1) % 3] - a[k];
+    const double beyond = e.cross(n).dot(p - a[k]);
+    if (!(beyond > 0)) continue;
+    // beyond / |e| is the distance past the line: compare those squared.
+    const double len2 = e.squaredNorm();
+    if (best < 0 || beyond * beyond * best_len2 > best_excess2 * len2) {
+      best = k;
+      best_excess2 = beyond * beyond;
+      best_len2 = len2;
+    }
+  }
+  return best;
+}
+
+// From the hint across the edges the point lies beyond, at most
+// kMaxWalk triangles: a guess of the closest triangle that only decides
+// where the certificate is tried, never the answer.
+uint32_t MeshIndex::WalkTowards(uint32_t hint_triangle, const Eigen::Vector3d& p) const {
+  uint32_t t = hint_triangle;
+  for (int step = 0; step < kMaxWalk; ++step) {
+    const int k = EdgeBeyond(t, p);
+    if (k < 0) break;
+    const uint32_t next = certificates_->of(t).across[k];
+    if (next == UINT32_MAX) break;
+    t = next;
+  }
+  return t;
+}
+
 std::size_t MeshIndex::memory_bytes() const {
-  return sizeof(*this) + mesh_.vertices.capacity() * sizeof(Eigen::Vector3f) +
-         mesh_.triangles.capacity() * sizeof(Triangle) +
+  return sizeof(*this) +
+         (mesh_.vertices.capacity() + ordered_.vertices.capacity()) * sizeof(Eigen::Vector3f) +
+         (mesh_.triangles.capacity() + ordered_.triangles.capacity()) * sizeof(Triangle) +
+         (mesh_triangle_.capacity() + position_of_triangle_.capacity()) * sizeof(uint32_t) +
          face_normal_.capacity() * sizeof(Eigen::Vector3d) + shape_.capacity() +
          triangle_edges_.capacity() * sizeof(triangle_edges_[0]) +
          edge_normal_.capacity() * sizeof(Eigen::Vector3d) + weld_.capacity() * sizeof(uint32_t) +

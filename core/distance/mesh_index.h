@@ -42,6 +42,7 @@ namespace surfinspect {
 
 class WideBvh;
 class HintCertificates;
+struct MeshOrder;
 
 struct ClosestPoint {
   uint32_t triangle_id = UINT32_MAX;  // UINT32_MAX = unmatched
@@ -126,8 +127,12 @@ class MeshIndex {
   const TriangleMesh& mesh() const { return mesh_; }
   const MeshIndexInfo& info() const { return info_; }
   // The BVH and the hint certificates (null when off), for their tests.
+  // Both number the triangles by their position in the index's spatial
+  // order (core/distance/mesh_order.h), not by mesh id.
   const WideBvh& bvh() const { return *bvh_; }
   const HintCertificates* hint_certificates() const { return certificates_.get(); }
+  uint32_t position_of(uint32_t triangle) const { return position_of_triangle_[triangle]; }
+  uint32_t mesh_triangle(uint32_t position) const { return mesh_triangle_[position]; }
   // Mesh, pseudonormals and the BVH, for an LRU cache of indices.
   std::size_t memory_bytes() const;
 
@@ -135,10 +140,19 @@ class MeshIndex {
   MeshIndex() = default;
   void ComputeFaceNormals();
   void ComputeFeatureNormals();  // mesh_index_normals.cpp
+  void ApplyOrder(MeshOrder order);
   const Eigen::Vector3d& Pseudonormal(uint32_t triangle, ClosestFeature feature) const;
   QueryPath CertifiedByHint(wide::Query& q, uint32_t hint_triangle) const;
+  int EdgeBeyond(uint32_t triangle, const Eigen::Vector3d& p) const;
+  uint32_t WalkTowards(uint32_t hint_triangle, const Eigen::Vector3d& p) const;
 
+  // The mesh as given, for mesh() and the answers' ids, and the same
+  // triangles in spatial order, which every array below follows (the
+  // per-vertex ones by the order's vertex positions).
   TriangleMesh mesh_;
+  TriangleMesh ordered_;
+  std::vector<uint32_t> mesh_triangle_;         // position -> mesh triangle id
+  std::vector<uint32_t> position_of_triangle_;  // mesh triangle id -> position
   MeshIndexInfo info_;
   std::vector<Eigen::Vector3d> face_normal_;             // per triangle, unit or 0
   std::vector<TriangleShape> shape_;                     // per triangle, for the kernel

@@ -83,7 +83,7 @@ Tally ExpectSoundProofs(const TriangleMesh& m, uint64_t seed) {
       const Vector3d p = on_face + (i % 2 ? 1 : -1) * offsets[i % 5] * n;
       const PointTriangleResult mine = ClosestPointOnTriangle(p, a[0], a[1], a[2]);
       if (mine.feature != ClosestFeature::kFace) continue;
-      if (!RingIsFarther(rise, p, mine.point, std::sqrt(mine.squared_distance), n, a)) continue;
+      if (!RingIsFarther(rise, p, mine.point, std::sqrt(mine.squared_distance), n, m, t)) continue;
       ++tally.proofs;
       for (uint32_t other : ring) {
         if (other == t) continue;

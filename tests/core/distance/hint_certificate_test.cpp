@@ -30,13 +30,19 @@ std::unique_ptr<MeshIndex> BuildWith(const TriangleMesh& mesh, bool certificates
   return index.ok() ? *std::move(index) : nullptr;
 }
 
-// The triangles in a certificate's lanes.
+// The mesh ids of the triangles in a certificate's lanes (which hold
+// positions in the index's order).
 std::set<uint32_t> RingOf(const MeshIndex& index, const HintCertificate& c) {
   std::set<uint32_t> ring;
   for (int j = 0; j < c.blocks; ++j)
     for (int lane = 0; lane < wide::kLeafWidth; ++lane)
-      if (c.lanes[j] >> lane & 1u) ring.insert(index.bvh().blocks()[c.block[j]].triangle[lane]);
+      if (c.lanes[j] >> lane & 1u)
+        ring.insert(index.mesh_triangle(index.bvh().blocks()[c.block[j]].triangle[lane]));
   return ring;
+}
+
+const HintCertificate& CertificateOf(const MeshIndex& index, uint32_t triangle) {
+  return index.hint_certificates()->of(index.position_of(triangle));
 }
 
 double TriangleDistance(const TriangleMesh& m, uint32_t t, const Vector3d& p) {
@@ -56,7 +62,7 @@ std::size_t ExpectSoundCertificates(const TriangleMesh& m) {
   if (!certificates) return 0;
   std::size_t certifiable = 0;
   for (uint32_t t = 0; t < m.num_triangles(); ++t) {
-    const HintCertificate& c = certificates->of(t);
+    const HintCertificate& c = CertificateOf(*index, t);
     if (c.reach_mm <= 0) continue;
     ++certifiable;
     const std::set<uint32_t> ring = RingOf(*index, c);
@@ -100,7 +106,7 @@ TEST(HintCertificates, ReachIsALowerBoundOutsideTheRing) {
   auto index = BuildWith(sheets, true);
   ASSERT_TRUE(index);
   for (uint32_t t = 0; t < sheets.num_triangles(); ++t)
-    EXPECT_LE(index->hint_certificates()->of(t).reach_mm, 0.05f) << t;
+    EXPECT_LE(CertificateOf(*index, t).reach_mm, 0.05f) << t;
   std::mt19937_64 rng(4);
   std::uniform_real_distribution<float> u(0, 50), d(-3, 3);
   TriangleMesh soup;
@@ -125,7 +131,7 @@ TEST(HintCertificates, AHighValenceVertexLeavesItsFanUncertified) {
   auto index = BuildWith(fan, true);
   ASSERT_TRUE(index);
   for (uint32_t t = 0; t < fan.num_triangles(); ++t)
-    EXPECT_EQ(index->hint_certificates()->of(t).reach_mm, 0.f) << t;
+    EXPECT_EQ(CertificateOf(*index, t).reach_mm, 0.f) << t;
   EXPECT_EQ(index->info().certifiable_triangles, 0u);
   // Still exact with any hint.
   const ClosestPoint want = index->Closest(Vector3d(3, 1, 0.5));
