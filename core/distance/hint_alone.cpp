@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "core/distance/point_triangle.h"
@@ -26,9 +27,14 @@ int EdgeOf(int i, int j) { return (i + j == 1) ? 0 : (i + j == 3) ? 1 : 2; }
 
 struct Lines {
   Eigen::Vector3d m[3];  // OutwardEdge
-  double len[3];
+  Eigen::Vector3d e[3];  // a_k+1 - a_k
+  double len[3], len2[3];
+  // The face's angles at both ends of edge k are at most 90 degrees, so
+  // every point of the face projects inside the edge.
+  bool projects_inside[3];
   const Eigen::Vector3d* a;
   double eta;
+  double longest, coordinate;  // the longest edge, the largest |coordinate| of a corner
   // Beyond edge line k widened by η, times the edge length (mm^2): >= 0 in G_k.
   double Beyond(int k, const Eigen::Vector3d& x) const { return m[k].dot(x - a[k]) + eta * len[k]; }
   bool Clear(int k, const Eigen::Vector3d& x) const { return Beyond(k, x) >= eta * len[k]; }
@@ -81,6 +87,148 @@ uint32_t PlaceNeighbour(const Lines& lines, const Eigen::Vector3d u[3], const in
   return 0;
 }
 
+// A corner of a placed neighbour: how far inside each widened G_k it lies
+// (T = Beyond, t |e_k|, mm^2), how far past an end of edge k along its line
+// (S = s |e_k|, mm^2, 0 unless the whole neighbour lies past that end), its
+// rise on each side with the rounding margin (mm), and the lines its
+// neighbour was placed beyond.
+struct Corner {
+  double inside[3];
+  double past[3];
+  double rise[2];
+  uint32_t placed;
+};
+
+// S for the corners u of one neighbour along edge k's line (see Corner):
+// e_k . (u - a_k) is s |e_k| from a_k, so a neighbour whose corners all
+// have it <= 0 lies past a_k, one whose corners all have it >= |e_k|^2
+// past a_k+1. Only where the face's angles at both ends of edge k are at
+// most 90 degrees does q project inside the edge, which the bound needs.
+// Less `margin` (mm^2) for the rounding of s at u and at q, floored at 0.
+void PastEnds(const Lines& lines, const Eigen::Vector3d u[3], int k, double margin,
+              double past[3]) {
+  const Eigen::Vector3d& e = lines.e[k];
+  const double len2 = lines.len2[k];
+  double s[3];
+  bool before = lines.projects_inside[k], after = lines.projects_inside[k];
+  for (int i = 0; i < 3; ++i) {
+    s[i] = e.dot(u[i] - lines.a[k]);
+    before = before && s[i] <= 0;
+    after = after && s[i] >= len2;
+  }
+  for (int i = 0; i < 3; ++i) {
+    const double beyond = before ? -s[i] : after ? s[i] - len2 : 0;
+    past[i] = std::max(0.0, beyond - margin);
+  }
+}
+
+Corner MakeCorner(const Lines& lines, const Eigen::Vector3d& n, const Eigen::Vector3d& u,
+                  uint32_t placed, const std::array<double, 3>& past) {
+  Corner c;
+  const Eigen::Vector3d up = u - lines.a[0];
+  const double margin = kRound * (up.lpNorm<1>() + lines.longest);  // over the normal's rounding
+  c.rise[0] = n.dot(up) + margin;
+  c.rise[1] = -n.dot(up) + margin;
+  for (int k = 0; k < 3; ++k) {
+    c.inside[k] = placed >> k & 1u ? lines.Beyond(k, u) : 0;
+    c.past[k] = past[k];
+  }
+  c.placed = placed;
+  return c;
+}
+
+// The fit rise |e_k|^2 <= A + B T + C S over the corners placed beyond
+// line k (`beyond`), for side +n and -n, all three >= 0: B from the
+// corners well inside G_k and not past an end, C from those well past an
+// end, then the least A. A alone makes the fit hold at every corner, so B
+// and C only need to be good, not exact: the largest ratios are picked by
+// cross-multiplying and divided once.
+void FitRise(const Corner* const* beyond, std::size_t count, int k, double len2, HintRise& out) {
+  double slope_num[2] = {0, 0}, slope_den[2] = {1, 1};
+  for (std::size_t i = 0; i < count; ++i) {
+    const Corner& c = *beyond[i];
+    if (c.past[k] != 0 || c.inside[k] < 0.1 * len2) continue;
+    for (int side = 0; side < 2; ++side)
+      if (c.rise[side] * slope_den[side] > slope_num[side] * c.inside[k]) {
+        slope_num[side] = c.rise[side];
+        slope_den[side] = c.inside[k];
+      }
+  }
+  double slope[2], end_num[2] = {0, 0}, end_den[2] = {1, 1};
+  for (int side = 0; side < 2; ++side) slope[side] = slope_num[side] * len2 / slope_den[side];
+  for (std::size_t i = 0; i < count; ++i) {
+    const Corner& c = *beyond[i];
+    if (c.past[k] < 0.1 * len2) continue;
+    for (int side = 0; side < 2; ++side) {
+      const double num = c.rise[side] * len2 - slope[side] * c.inside[k];
+      if (num * end_den[side] > end_num[side] * c.past[k]) {
+        end_num[side] = num;
+        end_den[side] = c.past[k];
+      }
+    }
+  }
+  for (int side = 0; side < 2; ++side) {
+    const double end = end_num[side] / end_den[side];
+    double base = 0;
+    for (std::size_t i = 0; i < count; ++i) {
+      const Corner& c = *beyond[i];
+      base = std::max(base, c.rise[side] * len2 - slope[side] * c.inside[k] - end * c.past[k]);
+    }
+    out.base[side][k] = RoundUpToFloat(base * (1 + 1e-12));
+    out.slope[side][k] = RoundUpToFloat(slope[side] * (1 + 1e-12));
+    out.end[side][k] = RoundUpToFloat(end * (1 + 1e-12));
+  }
+}
+
+// The face's edge lines; `a` must outlive them.
+Lines LinesOf(const Eigen::Vector3d a[3], const Eigen::Vector3d& n) {
+  Lines lines;
+  lines.a = a;
+  lines.longest = 0;
+  lines.coordinate = 0;
+  for (int k = 0; k < 3; ++k) {
+    lines.m[k] = OutwardEdge(a, k, n);
+    lines.e[k] = a[(k + 1) % 3] - a[k];
+    lines.len[k] = lines.e[k].norm();
+    lines.len2[k] = lines.e[k].squaredNorm();
+    const double apex = lines.e[k].dot(a[(k + 2) % 3] - a[k]);
+    lines.projects_inside[k] = apex >= 0 && apex <= lines.len2[k];
+    lines.longest = std::max(lines.longest, lines.len[k]);
+    lines.coordinate = std::max(lines.coordinate, a[k].cwiseAbs().maxCoeff());
+  }
+  lines.eta = kWiden * lines.longest;
+  return lines;
+}
+
+// The corners the fits run over, on the stack: a heap buffer per triangle
+// cost about a quarter of the certificates' build. At most two free
+// corners per neighbour, and two per line.
+struct CornerSet {
+  std::array<Corner, 2 * kMaxRiseRing + 6> items;
+  std::size_t used = 0;
+  uint32_t placed_any = 0;  // the lines some neighbour was placed beyond
+};
+
+// Places the ring triangle with corners u (shared as in PlaceNeighbour) and
+// adds its free corners; false when it fits none of the cases.
+bool AddNeighbour(const Lines& lines, const Eigen::Vector3d& n, const Eigen::Vector3d u[3],
+                  const int shared[3], CornerSet& set) {
+  const uint32_t placed = PlaceNeighbour(lines, u, shared);
+  if (placed == 0) return false;
+  double past[3][3] = {};  // [edge line][corner], only where placed
+  for (int k = 0; k < 3; ++k)
+    if (placed >> k & 1u)
+      PastEnds(lines, u, k, kRound * (lines.coordinate + lines.longest) * lines.len[k], past[k]);
+  // A shared corner is one of the face's corners on each line the
+  // neighbour was placed beyond: those are fitted once, by ComputeHintRise.
+  for (int i = 0; i < 3; ++i)
+    if (shared[i] < 0)
+      set.items[set.used++] =
+          MakeCorner(lines, n, u[i], placed, {past[0][i], past[1][i], past[2][i]});
+  set.placed_any |= placed;
+  return true;
+}
+
 }  // namespace
 
 HintRise ComputeHintRise(const TriangleMesh& mesh, const std::vector<uint32_t>& weld, uint32_t t,
@@ -90,17 +238,9 @@ HintRise ComputeHintRise(const TriangleMesh& mesh, const std::vector<uint32_t>& 
   Eigen::Vector3d a[3];
   for (int k = 0; k < 3; ++k) a[k] = mesh.vertices[tri[k]].cast<double>();
   if (ClassifyTriangle(a[0], a[1], a[2]) != TriangleShape::kRegular) return out;
-  Lines lines;
-  lines.a = a;
-  double longest = 0, coordinate = 0;
-  for (int k = 0; k < 3; ++k) {
-    lines.m[k] = OutwardEdge(a, k, n);
-    lines.len[k] = (a[(k + 1) % 3] - a[k]).norm();
-    longest = std::max(longest, lines.len[k]);
-    coordinate = std::max(coordinate, a[k].cwiseAbs().maxCoeff());
-  }
-  lines.eta = kWiden * longest;
-  double rise[2][3] = {};
+  if (ring_size > kMaxRiseRing) return out;
+  const Lines lines = LinesOf(a, n);
+  CornerSet set;
   for (std::size_t r = 0; r < ring_size; ++r) {
     const uint32_t u_id = ring[r];
     if (u_id == t) continue;
@@ -113,23 +253,23 @@ HintRise ComputeHintRise(const TriangleMesh& mesh, const std::vector<uint32_t>& 
       for (int k = 0; k < 3; ++k)
         if (weld[vertex] == weld[tri[k]]) shared[i] = k;
     }
-    const uint32_t placed = PlaceNeighbour(lines, u, shared);
-    if (placed == 0) return out;
-    for (int side = 0; side < 2; ++side) {
-      double h = 0;  // H+, with a margin over the normal's rounding
-      for (int i = 0; i < 3; ++i) {
-        const Eigen::Vector3d up = u[i] - a[0];
-        h = std::max(h, (side == 0 ? 1 : -1) * n.dot(up) + kRound * (up.lpNorm<1>() + longest));
-      }
-      for (int k = 0; k < 3; ++k)
-        if (placed >> k & 1u) rise[side][k] = std::max(rise[side][k], h);
-    }
+    if (!AddNeighbour(lines, n, u, shared, set)) return out;
   }
-  for (int side = 0; side < 2; ++side)
-    for (int k = 0; k < 3; ++k)
-      out.rise[side][k] = RoundUpToFloat(rise[side][k] * lines.len[k] * lines.len[k] * (1 + 1e-12));
-  out.tol_mm = RoundUpToFloat(lines.eta + kRound * (coordinate + longest));
-  out.longest_edge_mm = RoundUpToFloat(longest);
+  for (int k = 0; k < 3; ++k)
+    if (set.placed_any >> k & 1u)
+      for (int j : {k, (k + 1) % 3})
+        set.items[set.used++] = MakeCorner(lines, n, a[j], 1u << k, {});
+  for (int k = 0; k < 3; ++k) {
+    std::array<const Corner*, 2 * kMaxRiseRing + 6> beyond;
+    std::size_t count = 0;
+    for (std::size_t i = 0; i < set.used; ++i) {  // without a branch: the bits are irregular
+      beyond[count] = &set.items[i];
+      count += set.items[i].placed >> k & 1u;
+    }
+    FitRise(beyond.data(), count, k, lines.len2[k], out);
+  }
+  out.tol_mm = RoundUpToFloat(lines.eta + kRound * (lines.coordinate + lines.longest));
+  out.longest_edge_mm = RoundUpToFloat(lines.longest);
   out.valid = std::isfinite(out.tol_mm) && std::isfinite(out.longest_edge_mm);
   return out;
 }
@@ -153,7 +293,14 @@ bool RingIsFarther(const HintRise& rise, const Eigen::Vector3d& p, const Eigen::
   for (int k = 0; k < 3; ++k) {
     // δ_k |e_k| less the margins, at most (δ_k - η - rounding) |e_k|.
     const double inside = -OutwardEdge(a, k, n).dot(q - a[k]) - eps * longest;
-    if (!(inside > 0 && inside * inside > 2 * d_hi * rise.rise[side][k] + gap)) return false;
+    if (!(inside > 0)) return false;
+    // g at its minimiser (t*, s* = d γ), times |e_k|^2; g falls as d
+    // grows, so d_hi.
+    const double base = rise.base[side][k], slope = rise.slope[side][k];
+    const double end = d_hi * rise.end[side][k];
+    const double t = std::max(0.0, d_hi * slope - inside);
+    const double reach = inside + t;
+    if (!(reach * reach - 2 * d_hi * (base + slope * t) - end * end > gap)) return false;
   }
   return true;
 }

@@ -5,21 +5,40 @@
 // Let the kernel put p's closest point on the hint h at q inside h's face,
 // at distance d, with p on side σ of h's plane (unit normal n). Take a
 // triangle U of h's ring (it shares a vertex position with h) that lies in
-// G_k, the half-space beyond h's edge line k widened by η, and rises at
-// most H above h's plane on p's side. Every u in U then obeys
-//   |p - u|^2 = d^2 + |q - u|^2 - 2 d σn.(u - q) >= d^2 + δ_k^2 - 2 d H+,
-// δ_k the distance from q to G_k (|q - u| >= δ_k as u lies in G_k). So U
-// is farther from p than h whenever δ_k^2 > 2 d H+: a flat or convex ring
-// (H <= 0) only needs q off the edge line, a concave one needs q farther
-// in the more p lies above the face. An edge neighbour lies beyond its
+// G_k, the half-space beyond h's edge line k widened by η. With m and e the
+// line's unit outward normal and direction in the plane, δ_k the distance
+// from q to G_k, t(u) >= 0 how far u lies inside G_k and s(u) >= 0 how far
+// past an end of edge k along the line (0 unless all of U lies past that
+// end, and only where h's angles at both ends are at most 90 degrees, so
+// that q projects inside the edge), Bessel's inequality gives
+//   |q - u|^2 >= (m.(u - q))^2 + (e.(u - q))^2 >= (δ_k + t)^2 + s^2.
+// The rise of u above the plane on p's side, σn.(u - q), is at most
+// α + β t + γ s on all of U when it is at U's corners (both sides are
+// affine in u on U), with α, β, γ >= 0 fitted at build time. Then
+//   |p - u|^2 - d^2 = |q - u|^2 - 2 d σn.(u - q)
+//                   >= (δ_k + t)^2 - 2 d (α + β t) + s^2 - 2 d γ s,
+// smallest at t* = max(0, d β - δ_k) and s* = d γ, where it is
+//   g = (δ_k + t*)^2 - 2 d (α + β t*) - (d γ)^2.
+// So U is farther from p than h whenever g > 0: a flat or convex ring
+// (α = β = γ = 0) only needs q off the edge line; on a curved one, whose
+// rise grows with the distance from the line (β) and from the edge's ends
+// (γ), about the curvature times the ring's width, q must lie a little
+// inside, about d β / 2 + d γ. An edge neighbour lies beyond its
 // shared edge's line; a neighbour at one corner lies beyond one of the two
 // lines through it, or beyond their union, which holds when its two other
-// corners w1 (beyond line 1) and w2 (beyond line 2) satisfy
-// F1(w1) F2(w2) >= F1(w2) F2(w1), F_i the signed distance beyond line i
-// (the cone they span then misses the wedge between the lines).
+// corners w1 (beyond line 1) and w2 (beyond line 2) satisfy F1(w1) F2(w2)
+// >= F1(w2) F2(w1), F_i the signed distance beyond line i (the cone they
+// span then misses the wedge between the lines). The part of such a
+// neighbour beyond each line is covered by that line's test, with the fit
+// taken on all three of its corners.
 //
-// The rise per edge line and side is the largest H+ of the neighbours
-// placed beyond that line. Every comparison carries margins (η, the
+// The fit per edge line and side: β the largest slope rise / t over the
+// corners of the neighbours placed beyond that line that lie at least a
+// tenth of the edge's length inside G_k and not past an end, γ the largest
+// (rise - β t) / s over those at least a tenth past an end, then α the
+// least that covers every such corner. On the bench's torus this proves
+// the hint alone for 98% of the certified scan points, against 71% with the
+// rise bounded by its largest value. Every comparison carries margins (η, the
 // kernel's and the normal's rounding, a gap of 1e-10 of the coordinates'
 // square) that put the proof's inequalities far above the double
 // kernel's rounding, so the kernel's computed distances order the
@@ -36,13 +55,24 @@
 
 namespace surfinspect {
 
-// What the proof keeps per triangle.
+// What the proof keeps per triangle, [side +n, -n][edge AB, BC, CA],
+// rounded up: the fit α |e_k|^2 (mm^3), β |e_k| and γ |e_k| (mm), in which
+// units the test reads T = t |e_k| and S = s |e_k| (mm^2) and compares
+// squared lengths times |e_k|^2.
 struct HintRise {
-  float rise[2][3] = {};  // [side +n, -n][edge AB, BC, CA]: H+ |e_k|^2, mm^3, rounded up
-  float tol_mm = 0;       // η plus the build's rounding margin, rounded up
+  float base[2][3] = {};   // α |e_k|^2
+  float slope[2][3] = {};  // β |e_k|
+  float end[2][3] = {};    // γ |e_k|
+  float tol_mm = 0;        // η plus the build's rounding margin, rounded up
   float longest_edge_mm = 0;
   bool valid = false;  // false: the hint never proves itself alone
 };
+
+// The most ring entries a rise is computed over, repeats included; a
+// larger ring gets no proof. A certificate's ring holds at most 48
+// triangles (HintCertificate::kMaxBlocks blocks of 8 lanes), and it lists
+// each once per corner star it is in.
+constexpr std::size_t kMaxRiseRing = 3 * 48;
 
 // The rise of triangle `t` (unit normal `n`) over the triangles `ring`
 // (those sharing a vertex position with t; t itself and repeats are

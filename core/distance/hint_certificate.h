@@ -41,8 +41,8 @@
 namespace surfinspect {
 
 // The fields in the order a query reads them: a walk reads the first 40
-// bytes of each triangle it passes, a proof by the hint alone the next 36,
-// a ring's lanes the rest.
+// bytes of each triangle it passes, a proof by the hint alone the next 84,
+// a ring's lanes the rest (160 bytes in all).
 struct HintCertificate {
   static constexpr int kMaxBlocks = 6;
   double anchor[3] = {};  // m, mm, mesh frame

@@ -79,8 +79,8 @@ struct MeshIndexSettings {
 // part of a search per coherent query: a one-shot call (build, query once,
 // exit) gains from them only with this many points per triangle or more.
 // On the bench's 150k-triangle torus, two threads: ~1 us a triangle to
-// build, ~55 ns a point saved. An index that is kept (the server's cache,
-// calibration's many ICP iterations) builds them always.
+// build, ~67 ns a point saved, in scan order and in Morton order alike. An index that is kept (the
+// server's cache, calibration's many ICP iterations) builds them always.
 constexpr double kCertificatePointsPerTriangle = 16;
 inline bool CertificatesPayOnce(std::size_t points, std::size_t triangles) {
   return static_cast<double>(points) >= kCertificatePointsPerTriangle * triangles;

@@ -138,6 +138,28 @@ TEST(HintAlone, ProofsHoldAgainstTheRingByBruteForce) {
   }
 }
 
+// A neighbour at corner A that lies past the end of edge AB and rises at
+// 45 degrees: a point high over the face near AB is closer to it than to
+// the face, which only the bound along the edge's line (γ) sees; points
+// low over the face still get proofs, and every proof holds.
+TEST(HintAlone, ANeighbourRisingPastAnEdgesEndIsCounted) {
+  TriangleMesh m;
+  m.vertices = {{0, 0, 0}, {10, 0, 0}, {5, 10, 0}, {-10, -0.1f, 10}, {-10, -2, 10}};
+  m.triangles = {{0, 1, 2}, {0, 4, 3}};
+  const std::vector<uint32_t> weld = Weld(m);
+  const std::vector<uint32_t> ring = Ring(m, weld, 0);
+  const Vector3d n = Normal(m, 0);
+  const HintRise rise = ComputeHintRise(m, weld, 0, n, ring.data(), ring.size());
+  ASSERT_TRUE(rise.valid);
+  const Vector3d a[3] = {V(m, 0), V(m, 1), V(m, 2)};
+  const Vector3d p(3, 0.5, 10);
+  const PointTriangleResult face = ClosestPointOnTriangle(p, a[0], a[1], a[2]);
+  ASSERT_EQ(face.feature, ClosestFeature::kFace);
+  ASSERT_LT(D2(m, 1, p), face.squared_distance);  // the neighbour is closer
+  EXPECT_FALSE(RingIsFarther(rise, p, face.point, std::sqrt(face.squared_distance), n, m, 0));
+  EXPECT_GT(ExpectSoundProofs(m, 8).proofs, 3);
+}
+
 // Two triangles over the same corners, a neighbour folded back over the
 // face, and a sliver: no proof.
 TEST(HintAlone, NoProofForDuplicatesFoldsAndSlivers) {
