@@ -141,7 +141,8 @@ TEST(HintAlone, ProofsHoldAgainstTheRingByBruteForce) {
 // A neighbour at corner A that lies past the end of edge AB and rises at
 // 45 degrees: a point high over the face near AB is closer to it than to
 // the face, which only the bound along the edge's line (γ) sees; points
-// low over the face still get proofs, and every proof holds.
+// low over the face still get proofs, and every proof holds. Where the
+// face's angle at A is obtuse that bound must not be used at all.
 TEST(HintAlone, ANeighbourRisingPastAnEdgesEndIsCounted) {
   TriangleMesh m;
   m.vertices = {{0, 0, 0}, {10, 0, 0}, {5, 10, 0}, {-10, -0.1f, 10}, {-10, -2, 10}};
@@ -158,6 +159,21 @@ TEST(HintAlone, ANeighbourRisingPastAnEdgesEndIsCounted) {
   ASSERT_LT(D2(m, 1, p), face.squared_distance);  // the neighbour is closer
   EXPECT_FALSE(RingIsFarther(rise, p, face.point, std::sqrt(face.squared_distance), n, m, 0));
   EXPECT_GT(ExpectSoundProofs(m, 8).proofs, 3);
+
+  // The face's angle at A is obtuse, so q can project past A as far as the
+  // gently rising neighbour reaches: the bound along the line must not
+  // apply there.
+  m.vertices = {{0, 0, 0}, {10, 0, 0}, {-20, 2, 0}, {-20, -0.1f, 2}, {-20, -3, 2}};
+  const HintRise obtuse = ComputeHintRise(m, weld, 0, Normal(m, 0), ring.data(), ring.size());
+  ASSERT_TRUE(obtuse.valid);
+  const Vector3d a2[3] = {V(m, 0), V(m, 1), V(m, 2)};
+  const Vector3d low(-15, 1.6, 3);
+  const PointTriangleResult over = ClosestPointOnTriangle(low, a2[0], a2[1], a2[2]);
+  ASSERT_EQ(over.feature, ClosestFeature::kFace);
+  ASSERT_LT(D2(m, 1, low), over.squared_distance);
+  EXPECT_FALSE(
+      RingIsFarther(obtuse, low, over.point, std::sqrt(over.squared_distance), Normal(m, 0), m, 0));
+  ExpectSoundProofs(m, 9);
 }
 
 // Two triangles over the same corners, a neighbour folded back over the
