@@ -124,21 +124,30 @@ absl::StatusOr<std::unique_ptr<MeshIndex>> MeshIndex::Build(TriangleMesh mesh,
       // edge and vertex pseudonormals on the mesh's, so that their sums
       // add in the mesh's order. They are serial work: they run beside
       // Embree's parallel build instead of before it.
-      MeshOrder order = OrderMesh(index->mesh_);
-      std::vector<Eigen::Vector3d> ordered_normal(order.mesh_triangle.size());
-      std::vector<TriangleShape> ordered_shape(order.mesh_triangle.size());
-      for (std::size_t i = 0; i < order.mesh_triangle.size(); ++i) {
-        ordered_normal[i] = index->face_normal_[order.mesh_triangle[i]];
-        ordered_shape[i] = index->shape_[order.mesh_triangle[i]];
+      MeshOrder order =
+          settings.hint_certificates ? OrderMesh(index->mesh_) : KeepOrder(index->mesh_);
+      std::vector<Eigen::Vector3d> ordered_normal;
+      std::vector<TriangleShape> ordered_shape;
+      if (!order.identity) {
+        ordered_normal.resize(order.mesh_triangle.size());
+        ordered_shape.resize(order.mesh_triangle.size());
+        for (std::size_t i = 0; i < order.mesh_triangle.size(); ++i) {
+          ordered_normal[i] = index->face_normal_[order.mesh_triangle[i]];
+          ordered_shape[i] = index->shape_[order.mesh_triangle[i]];
+        }
       }
       tbb::parallel_invoke(
           [&] {
-            bvh = WideBvh::Build((*device)->get(), order.ordered, ordered_normal, ordered_shape,
+            bvh = WideBvh::Build((*device)->get(), order.ordered,
+                                 order.identity ? index->face_normal_ : ordered_normal,
+                                 order.identity ? index->shape_ : ordered_shape,
                                  EmbreeBuildQuality(settings.build_quality), settings.search_isa);
           },
           [&] { index->ComputeFeatureNormals(); });
-      index->face_normal_ = std::move(ordered_normal);
-      index->shape_ = std::move(ordered_shape);
+      if (!order.identity) {
+        index->face_normal_ = std::move(ordered_normal);
+        index->shape_ = std::move(ordered_shape);
+      }
       index->ApplyOrder(std::move(order));
     } catch (const std::bad_alloc&) {
       bvh = absl::ResourceExhaustedError(
@@ -205,8 +214,12 @@ void MeshIndex::ComputeFaceNormals() {
 // Moves the per-triangle and per-vertex data, computed in the mesh's
 // order, to the spatial order's positions; the values are unchanged.
 void MeshIndex::ApplyOrder(MeshOrder order) {
+  ordered_ = std::move(order.ordered);
+  mesh_triangle_ = std::move(order.mesh_triangle);
+  position_of_triangle_ = std::move(order.position_of_triangle);
+  if (order.identity) return;
   std::vector<std::array<uint32_t, 3>> edges(triangle_edges_.size());
-  for (std::size_t i = 0; i < edges.size(); ++i) edges[i] = triangle_edges_[order.mesh_triangle[i]];
+  for (std::size_t i = 0; i < edges.size(); ++i) edges[i] = triangle_edges_[mesh_triangle_[i]];
   triangle_edges_ = std::move(edges);
   // A vertex's representative keeps its role under its new position.
   std::vector<uint32_t> weld(weld_.size());
@@ -218,9 +231,6 @@ void MeshIndex::ApplyOrder(MeshOrder order) {
   }
   weld_ = std::move(weld);
   vertex_normal_ = std::move(vertex_normal);
-  ordered_ = std::move(order.ordered);
-  mesh_triangle_ = std::move(order.mesh_triangle);
-  position_of_triangle_ = std::move(order.position_of_triangle);
 }
 
 const Eigen::Vector3d& MeshIndex::Pseudonormal(uint32_t triangle, ClosestFeature feature) const {

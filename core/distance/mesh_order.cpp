@@ -1,5 +1,7 @@
 #include "core/distance/mesh_order.h"
 
+#include <numeric>
+
 #include "core/distance/morton_order.h"
 #include "core/types/point_cloud.h"
 
@@ -41,6 +43,18 @@ MeshOrder OrderMesh(const TriangleMesh& mesh) {
     out.ordered.triangles[i] = {place(tri[0]), place(tri[1]), place(tri[2])};
   }
   for (uint32_t v = 0; v < vertices; ++v) place(v);
+  return out;
+}
+
+MeshOrder KeepOrder(const TriangleMesh& mesh) {
+  MeshOrder out;
+  out.mesh_triangle.resize(mesh.triangles.size());
+  std::iota(out.mesh_triangle.begin(), out.mesh_triangle.end(), 0u);
+  out.position_of_triangle = out.mesh_triangle;
+  out.position_of_vertex.resize(mesh.vertices.size());
+  std::iota(out.position_of_vertex.begin(), out.position_of_vertex.end(), 0u);
+  out.ordered = mesh;
+  out.identity = true;
   return out;
 }
 

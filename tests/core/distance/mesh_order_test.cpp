@@ -68,6 +68,20 @@ TEST(MeshOrder, IsARenumberingThatKeepsEveryTriangleAndItsCorners) {
   EXPECT_TRUE(order.ordered.Validate().ok());
 }
 
+TEST(MeshOrder, KeepOrderIsTheIdentity) {
+  const TriangleMesh m = ShuffledTorus(5);
+  const MeshOrder order = KeepOrder(m);
+  for (uint32_t t = 0; t < m.num_triangles(); ++t) {
+    EXPECT_EQ(order.mesh_triangle[t], t);
+    EXPECT_EQ(order.position_of_triangle[t], t);
+    EXPECT_EQ(order.ordered.triangles[t], m.triangles[t]);
+  }
+  for (uint32_t v = 0; v < m.vertices.size(); ++v) EXPECT_EQ(order.position_of_vertex[v], v);
+  EXPECT_EQ(order.ordered.vertices, m.vertices);
+  EXPECT_TRUE(order.identity);
+  EXPECT_FALSE(OrderMesh(m).identity);
+}
+
 TEST(MeshOrder, PutsNearTrianglesNearInMemory) {
   const TriangleMesh m = ShuffledTorus(2);
   const double shuffled = MeanStep(m);
