@@ -178,8 +178,10 @@ HintCertificates HintCertificates::Build(const TriangleMesh& mesh,
                         for (int k = 0; k < 3; ++k)
                           v[k] = mesh.vertices[mesh.triangles[t][k]].cast<double>();
                         SetReach(bvh, v, c);
-                        c.rise = ComputeHintRise(mesh, weld, static_cast<uint32_t>(t),
-                                                 face_normals[t], ring.data(), ring.size());
+                        // Without a reach the rise would never be asked.
+                        if (c.reach_mm > 0)
+                          c.rise = ComputeHintRise(mesh, weld, static_cast<uint32_t>(t),
+                                                   face_normals[t], ring.data(), ring.size());
                         SetAcross(stars, mesh, weld, static_cast<uint32_t>(t), c);
                       }
                     });
