@@ -34,7 +34,7 @@ struct Lines {
   bool projects_inside[3];
   const Eigen::Vector3d* a;
   double eta;
-  double longest, coordinate;  // the longest edge, the largest |coordinate| of a corner
+  double longest = 0, coordinate = 0;  // the longest edge, the largest |coordinate| of a corner
   // Beyond edge line k widened by η, times the edge length (mm^2): >= 0 in G_k.
   double Beyond(int k, const Eigen::Vector3d& x) const { return m[k].dot(x - a[k]) + eta * len[k]; }
   bool Clear(int k, const Eigen::Vector3d& x) const { return Beyond(k, x) >= eta * len[k]; }
@@ -93,9 +93,7 @@ uint32_t PlaceNeighbour(const Lines& lines, const Eigen::Vector3d u[3], const in
 // rise on each side with the rounding margin (mm), and the lines its
 // neighbour was placed beyond.
 struct Corner {
-  double inside[3];
-  double past[3];
-  double rise[2];
+  double inside[3], past[3], rise[2];
   uint32_t placed;
 };
 
@@ -107,17 +105,15 @@ struct Corner {
 // Less `margin` (mm^2) for the rounding of s at u and at q, floored at 0.
 void PastEnds(const Lines& lines, const Eigen::Vector3d u[3], int k, double margin,
               double past[3]) {
-  const Eigen::Vector3d& e = lines.e[k];
-  const double len2 = lines.len2[k];
   double s[3];
   bool before = lines.projects_inside[k], after = lines.projects_inside[k];
   for (int i = 0; i < 3; ++i) {
-    s[i] = e.dot(u[i] - lines.a[k]);
+    s[i] = lines.e[k].dot(u[i] - lines.a[k]);
     before = before && s[i] <= 0;
-    after = after && s[i] >= len2;
+    after = after && s[i] >= lines.len2[k];
   }
   for (int i = 0; i < 3; ++i) {
-    const double beyond = before ? -s[i] : after ? s[i] - len2 : 0;
+    const double beyond = before ? -s[i] : after ? s[i] - lines.len2[k] : 0;
     past[i] = std::max(0.0, beyond - margin);
   }
 }
@@ -184,8 +180,6 @@ void FitRise(const Corner* const* beyond, std::size_t count, int k, double len2,
 Lines LinesOf(const Eigen::Vector3d a[3], const Eigen::Vector3d& n) {
   Lines lines;
   lines.a = a;
-  lines.longest = 0;
-  lines.coordinate = 0;
   for (int k = 0; k < 3; ++k) {
     lines.m[k] = OutwardEdge(a, k, n);
     lines.e[k] = a[(k + 1) % 3] - a[k];
@@ -200,9 +194,8 @@ Lines LinesOf(const Eigen::Vector3d a[3], const Eigen::Vector3d& n) {
   return lines;
 }
 
-// The corners the fits run over, on the stack: a heap buffer per triangle
-// cost about a quarter of the certificates' build. At most two free
-// corners per neighbour, and two per line.
+// The corners the fits run over, on the stack (a heap buffer per triangle cost a
+// quarter of the certificates' build): at most two free per neighbour, two per line.
 struct CornerSet {
   std::array<Corner, 2 * kMaxRiseRing + 6> items;
   std::size_t used = 0;
@@ -277,9 +270,8 @@ HintRise ComputeHintRise(const TriangleMesh& mesh, const std::vector<uint32_t>& 
 bool RingIsFarther(const HintRise& rise, const Eigen::Vector3d& p, const Eigen::Vector3d& q,
                    double d, const Eigen::Vector3d& n, const TriangleMesh& mesh, uint32_t t) {
   if (!rise.valid) return false;
-  // The corners are widened here, not by the caller: a caller's array of
-  // doubles, written one coordinate at a time and read here two at a time,
-  // stalls every load on a failed store forward.
+  // Widened here: a caller's array of doubles, stored one coordinate at a time and
+  // loaded here two at a time, stalls every load on a failed store forward.
   const Triangle& tri = mesh.triangles[t];
   const Eigen::Vector3d a[3] = {mesh.vertices[tri[0]].cast<double>(),
                                 mesh.vertices[tri[1]].cast<double>(),

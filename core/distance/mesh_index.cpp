@@ -1,8 +1,5 @@
 #include "core/distance/mesh_index.h"
 
-#include <tbb/parallel_invoke.h>
-#include <tbb/task_arena.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -10,9 +7,7 @@
 #include <new>
 
 #include "absl/strings/str_cat.h"
-#include "core/distance/embree_handles.h"
 #include "core/distance/hint_certificate.h"
-#include "core/distance/mesh_order.h"
 #include "core/distance/wide_bvh.h"
 
 namespace surfinspect {
@@ -98,140 +93,6 @@ constexpr int kMaxWalk = 3;
 }  // namespace
 
 MeshIndex::~MeshIndex() = default;
-
-absl::StatusOr<std::unique_ptr<MeshIndex>> MeshIndex::Build(TriangleMesh mesh,
-                                                            const MeshIndexSettings& settings) {
-  if (settings.build_threads < 0)
-    return absl::InvalidArgumentError(
-        absl::StrCat("mesh index: build_threads must be >= 0, got ", settings.build_threads));
-  if (auto st = mesh.Validate(); !st.ok()) return st;
-  if (mesh.triangles.size() >= UINT32_MAX || mesh.vertices.size() >= UINT32_MAX)
-    return absl::InvalidArgumentError("mesh index: more than 2^32-1 triangles or vertices");
-  const auto start = std::chrono::steady_clock::now();
-  std::unique_ptr<MeshIndex> index(new MeshIndex());
-  index->mesh_ = std::move(mesh);
-  index->ComputeFaceNormals();
-  auto device = EmbreeDevice::Create();
-  if (!device.ok()) return device.status();
-  // Embree builds with TBB; an arena bounds the build's threads without a
-  // process-global limit (Embree's own "threads=" config sets one).
-  tbb::task_arena arena(settings.build_threads > 0 ? settings.build_threads
-                                                   : tbb::task_arena::automatic);
-  absl::StatusOr<WideBvh> bvh;
-  arena.execute([&] {
-    try {
-      // The BVH and the certificates are built on the spatial order; the
-      // edge and vertex pseudonormals on the mesh's, so that their sums
-      // add in the mesh's order. They are serial work: they run beside
-      // Embree's parallel build instead of before it.
-      MeshOrder order =
-          settings.hint_certificates ? OrderMesh(index->mesh_) : KeepOrder(index->mesh_);
-      std::vector<Eigen::Vector3d> ordered_normal;
-      std::vector<TriangleShape> ordered_shape;
-      if (!order.identity) {
-        ordered_normal.resize(order.mesh_triangle.size());
-        ordered_shape.resize(order.mesh_triangle.size());
-        for (std::size_t i = 0; i < order.mesh_triangle.size(); ++i) {
-          ordered_normal[i] = index->face_normal_[order.mesh_triangle[i]];
-          ordered_shape[i] = index->shape_[order.mesh_triangle[i]];
-        }
-      }
-      tbb::parallel_invoke(
-          [&] {
-            bvh = WideBvh::Build((*device)->get(), order.ordered,
-                                 order.identity ? index->face_normal_ : ordered_normal,
-                                 order.identity ? index->shape_ : ordered_shape,
-                                 EmbreeBuildQuality(settings.build_quality), settings.search_isa);
-          },
-          [&] { index->ComputeFeatureNormals(); });
-      if (!order.identity) {
-        index->face_normal_ = std::move(ordered_normal);
-        index->shape_ = std::move(ordered_shape);
-      }
-      index->ApplyOrder(std::move(order));
-    } catch (const std::bad_alloc&) {
-      bvh = absl::ResourceExhaustedError(
-          absl::StrCat("mesh index: out of memory building the index of ",
-                       index->mesh_.num_triangles(), " triangles"));
-    }
-  });
-  if (!bvh.ok()) {
-    if (auto st = (*device)->TakeError(); !st.ok()) return st;
-    return bvh.status();
-  }
-  index->bvh_ = std::make_unique<WideBvh>(*std::move(bvh));
-  if (settings.hint_certificates) {
-    const auto certificate_start = std::chrono::steady_clock::now();
-    bool out_of_memory = false;
-    arena.execute([&] {
-      try {
-        index->certificates_ = std::make_unique<HintCertificates>(HintCertificates::Build(
-            index->ordered_, index->weld_, index->face_normal_, *index->bvh_));
-      } catch (const std::bad_alloc&) {
-        out_of_memory = true;
-      }
-    });
-    if (out_of_memory)
-      return absl::ResourceExhaustedError(
-          absl::StrCat("mesh index: out of memory building the hint certificates of ",
-                       index->mesh_.num_triangles(), " triangles"));
-    index->info_.certifiable_triangles = index->certificates_->certifiable();
-    index->info_.hint_alone_triangles = index->certificates_->alone();
-    index->info_.certificate_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - certificate_start).count();
-  }
-  index->info_.triangles = index->mesh_.num_triangles();
-  index->info_.bvh_nodes = index->bvh_->stats().nodes;
-  index->info_.bvh_depth = index->bvh_->stats().depth;
-  index->info_.search_isa = SearchIsaName(index->bvh_->isa());
-  index->info_.build_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return index;
-}
-
-// The face normals and kernel shapes, which the BVH needs; the edge and
-// vertex pseudonormals below are built beside it.
-void MeshIndex::ComputeFaceNormals() {
-  const auto& verts = mesh_.vertices;
-  const auto& tris = mesh_.triangles;
-  face_normal_.assign(tris.size(), Eigen::Vector3d::Zero());
-  shape_.resize(tris.size());
-  for (std::size_t t = 0; t < tris.size(); ++t) {
-    // The kernel's degeneracy test is TriangleMesh::IsDegenerate's.
-    shape_[t] = ClassifyTriangle(verts[tris[t][0]].cast<double>(), verts[tris[t][1]].cast<double>(),
-                                 verts[tris[t][2]].cast<double>());
-    if (shape_[t] == TriangleShape::kDegenerate) {
-      ++info_.degenerate_triangles;
-      continue;  // a zero normal: contributes nothing to its neighbours' sums
-    }
-    const Eigen::Vector3d a = verts[tris[t][0]].cast<double>(),
-                          b = verts[tris[t][1]].cast<double>(),
-                          c = verts[tris[t][2]].cast<double>();
-    face_normal_[t] = (b - a).cross(c - a).normalized();
-  }
-}
-
-// Moves the per-triangle and per-vertex data, computed in the mesh's
-// order, to the spatial order's positions; the values are unchanged.
-void MeshIndex::ApplyOrder(MeshOrder order) {
-  ordered_ = std::move(order.ordered);
-  mesh_triangle_ = std::move(order.mesh_triangle);
-  position_of_triangle_ = std::move(order.position_of_triangle);
-  if (order.identity) return;
-  std::vector<std::array<uint32_t, 3>> edges(triangle_edges_.size());
-  for (std::size_t i = 0; i < edges.size(); ++i) edges[i] = triangle_edges_[mesh_triangle_[i]];
-  triangle_edges_ = std::move(edges);
-  // A vertex's representative keeps its role under its new position.
-  std::vector<uint32_t> weld(weld_.size());
-  std::vector<Eigen::Vector3d> vertex_normal(vertex_normal_.size());
-  for (std::size_t v = 0; v < weld_.size(); ++v) {
-    const uint32_t at = order.position_of_vertex[v];
-    weld[at] = order.position_of_vertex[weld_[v]];
-    vertex_normal[at] = vertex_normal_[v];
-  }
-  weld_ = std::move(weld);
-  vertex_normal_ = std::move(vertex_normal);
-}
 
 const Eigen::Vector3d& MeshIndex::Pseudonormal(uint32_t triangle, ClosestFeature feature) const {
   const int k = FeatureIndex(feature);

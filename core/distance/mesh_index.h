@@ -38,6 +38,8 @@
 #include "core/types/point_cloud.h"
 #include "core/types/triangle_mesh.h"
 
+struct RTCDeviceTy;  // Embree's device (RTCDevice)
+
 namespace surfinspect {
 
 class WideBvh;
@@ -141,6 +143,9 @@ class MeshIndex {
   void ComputeFaceNormals();
   void ComputeFeatureNormals();  // mesh_index_normals.cpp
   void ApplyOrder(MeshOrder order);
+  // mesh_index_build.cpp; both run on `settings.build_threads` threads.
+  absl::StatusOr<WideBvh> BuildInOrder(RTCDeviceTy* device, const MeshIndexSettings& settings);
+  absl::Status BuildCertificates(const MeshIndexSettings& settings);
   const Eigen::Vector3d& Pseudonormal(uint32_t triangle, ClosestFeature feature) const;
   QueryPath CertifiedByHint(wide::Query& q, uint32_t hint_triangle) const;
   int EdgeBeyond(uint32_t triangle, const Eigen::Vector3d& p) const;

@@ -1,7 +1,8 @@
 // Covers core/distance/mesh_index.cpp (MeshIndex::Closest against brute force),
-// core/distance/mesh_index_normals.cpp (signs against winding numbers) and
-// core/distance/mesh_index_batch.cpp (QueryClosest and QueryClosestEach:
-// one and many threads, coherent start, Morton order, cancel, bad input).
+// core/distance/mesh_index_normals.cpp (signs against winding numbers),
+// core/distance/mesh_index_build.cpp (Build, in either triangle order, with
+// and without certificates) and core/distance/mesh_index_batch.cpp (QueryClosest and
+// QueryClosestEach: one and many threads, coherent start, Morton order, cancel, bad input).
 #include "core/distance/mesh_index.h"
 
 #include <gtest/gtest.h>
