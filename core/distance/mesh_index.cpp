@@ -161,8 +161,8 @@ ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_dis
 // (core/distance/hint_certificate.h); kTree otherwise.
 QueryPath MeshIndex::CertifiedByHint(wide::Query& q, uint32_t hint_triangle) const {
   const auto& s = *static_cast<const QueryState*>(q.context);
-  // Two steps move the anchor by about a triangle: a point farther than
-  // twice the hint's reach from its anchor would not certify after them.
+  // A point more than twice the hint's reach from its anchor is not a
+  // coherent query's: it goes to the tree without a walk.
   if (!certificates_->of(hint_triangle).Near(s.p, 2)) return QueryPath::kTree;
   // Most hints are a triangle off: walking by the edge lines costs less
   // than the kernel on each triangle passed.

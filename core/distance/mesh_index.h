@@ -81,8 +81,9 @@ struct MeshIndexSettings {
 // part of a search per coherent query: a one-shot call (build, query once,
 // exit) gains from them only with this many points per triangle or more.
 // On the bench's 150k-triangle torus, two threads: ~1 us a triangle to
-// build, ~67 ns a point saved, in scan order and in Morton order alike. An index that is kept (the
-// server's cache, calibration's many ICP iterations) builds them always.
+// build, ~67 ns a point saved, in scan order and in Morton order alike.
+// An index that is kept (the server's cache, calibration's many ICP
+// iterations) builds them always.
 constexpr double kCertificatePointsPerTriangle = 16;
 inline bool CertificatesPayOnce(std::size_t points, std::size_t triangles) {
   return static_cast<double>(points) >= kCertificatePointsPerTriangle * triangles;
@@ -129,8 +130,8 @@ class MeshIndex {
   const TriangleMesh& mesh() const { return mesh_; }
   const MeshIndexInfo& info() const { return info_; }
   // The BVH and the hint certificates (null when off), for their tests.
-  // Both number the triangles by their position in the index's spatial
-  // order (core/distance/mesh_order.h), not by mesh id.
+  // Both number the triangles by their position in the index's order
+  // (core/distance/mesh_order.h), not by mesh id.
   const WideBvh& bvh() const { return *bvh_; }
   const HintCertificates* hint_certificates() const { return certificates_.get(); }
   uint32_t position_of(uint32_t triangle) const { return position_of_triangle_[triangle]; }
@@ -152,8 +153,9 @@ class MeshIndex {
   uint32_t WalkTowards(uint32_t hint_triangle, const Eigen::Vector3d& p) const;
 
   // The mesh as given, for mesh() and the answers' ids, and the same
-  // triangles in spatial order, which every array below follows (the
-  // per-vertex ones by the order's vertex positions).
+  // triangles in the index's order (spatial with certificates, the mesh's
+  // own without), which every array below follows (the per-vertex ones by
+  // the order's vertex positions).
   TriangleMesh mesh_;
   TriangleMesh ordered_;
   std::vector<uint32_t> mesh_triangle_;         // position -> mesh triangle id
