@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <new>
 
 #include "core/distance/point_triangle.h"
 #include "core/distance/wide_bvh.h"
@@ -112,10 +113,8 @@ void PastEnds(const Lines& lines, const Eigen::Vector3d u[3], int k, double marg
     before = before && s[i] <= 0;
     after = after && s[i] >= lines.len2[k];
   }
-  for (int i = 0; i < 3; ++i) {
-    const double beyond = before ? -s[i] : after ? s[i] - lines.len2[k] : 0;
-    past[i] = std::max(0.0, beyond - margin);
-  }
+  for (int i = 0; i < 3; ++i)
+    past[i] = std::max(0.0, (before ? -s[i] : after ? s[i] - lines.len2[k] : 0) - margin);
 }
 
 Corner MakeCorner(const Lines& lines, const Eigen::Vector3d& n, const Eigen::Vector3d& u,
@@ -196,6 +195,7 @@ Lines LinesOf(const Eigen::Vector3d a[3], const Eigen::Vector3d& n) {
 
 // The corners the fits run over, on the stack (a heap buffer per triangle cost a
 // quarter of the certificates' build): at most two free per neighbour, two per line.
+// Each is built in place: a copy's loads would wait on failed store forwards.
 struct CornerSet {
   std::array<Corner, 2 * kMaxRiseRing + 6> items;
   std::size_t used = 0;
@@ -216,8 +216,8 @@ bool AddNeighbour(const Lines& lines, const Eigen::Vector3d& n, const Eigen::Vec
   // neighbour was placed beyond: those are fitted once, by ComputeHintRise.
   for (int i = 0; i < 3; ++i)
     if (shared[i] < 0)
-      set.items[set.used++] =
-          MakeCorner(lines, n, u[i], placed, {past[0][i], past[1][i], past[2][i]});
+      ::new (&set.items[set.used++])
+          Corner(MakeCorner(lines, n, u[i], placed, {past[0][i], past[1][i], past[2][i]}));
   set.placed_any |= placed;
   return true;
 }
@@ -251,7 +251,7 @@ HintRise ComputeHintRise(const TriangleMesh& mesh, const std::vector<uint32_t>& 
   for (int k = 0; k < 3; ++k)
     if (set.placed_any >> k & 1u)
       for (int j : {k, (k + 1) % 3})
-        set.items[set.used++] = MakeCorner(lines, n, a[j], 1u << k, {});
+        ::new (&set.items[set.used++]) Corner(MakeCorner(lines, n, a[j], 1u << k, {}));
   for (int k = 0; k < 3; ++k) {
     std::array<const Corner*, 2 * kMaxRiseRing + 6> beyond;
     std::size_t count = 0;
