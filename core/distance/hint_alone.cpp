@@ -88,22 +88,20 @@ uint32_t PlaceNeighbour(const Lines& lines, const Eigen::Vector3d u[3], const in
   return 0;
 }
 
-// A corner of a placed neighbour: how far inside each widened G_k it lies
-// (T = Beyond, t |e_k|, mm^2), how far past an end of edge k along its line
-// (S = s |e_k|, mm^2, 0 unless the whole neighbour lies past that end), its
-// rise on each side with the rounding margin (mm), and the lines its
-// neighbour was placed beyond.
+// A corner of a placed neighbour: how far inside each widened G_k it lies (T =
+// Beyond, t |e_k|, mm^2), how far past an end of edge k along its line (S = s |e_k|,
+// mm^2, 0 unless the whole neighbour lies past that end), its rise on each side
+// with the rounding margin (mm), and the lines its neighbour was placed beyond.
 struct Corner {
   double inside[3], past[3], rise[2];
   uint32_t placed;
 };
 
-// S for the corners u of one neighbour along edge k's line (see Corner):
-// e_k . (u - a_k) is s |e_k| from a_k, so a neighbour whose corners all
-// have it <= 0 lies past a_k, one whose corners all have it >= |e_k|^2
-// past a_k+1. Only where the face's angles at both ends of edge k are at
-// most 90 degrees does q project inside the edge, which the bound needs.
-// Less `margin` (mm^2) for the rounding of s at u and at q, floored at 0.
+// S for the corners u of one neighbour along edge k's line (see Corner): e_k .
+// (u - a_k) is s |e_k| from a_k, so a neighbour whose corners all have it <= 0 lies
+// past a_k, one whose corners all have it >= |e_k|^2 past a_k+1. Only where the
+// face's angles at both ends of edge k are at most 90 degrees does q project inside
+// the edge, which the bound needs. Less `margin` (mm^2) for s's rounding, floor 0.
 void PastEnds(const Lines& lines, const Eigen::Vector3d u[3], int k, double margin,
               double past[3]) {
   double s[3];
@@ -137,7 +135,8 @@ Corner MakeCorner(const Lines& lines, const Eigen::Vector3d& n, const Eigen::Vec
 // corners well inside G_k and not past an end, C from those well past an
 // end, then the least A. A alone makes the fit hold at every corner, so B
 // and C only need to be good, not exact: the largest ratios are picked by
-// cross-multiplying and divided once.
+// cross-multiplying and divided once. A is fitted to B and C as stored (rounded
+// up to float), so the fit also holds at corners with T < 0 (placed by a union).
 void FitRise(const Corner* const* beyond, std::size_t count, int k, double len2, HintRise& out) {
   double slope_num[2] = {0, 0}, slope_den[2] = {1, 1};
   for (std::size_t i = 0; i < count; ++i) {
@@ -150,7 +149,8 @@ void FitRise(const Corner* const* beyond, std::size_t count, int k, double len2,
       }
   }
   double slope[2], end_num[2] = {0, 0}, end_den[2] = {1, 1};
-  for (int side = 0; side < 2; ++side) slope[side] = slope_num[side] * len2 / slope_den[side];
+  for (int side = 0; side < 2; ++side)
+    slope[side] = RoundUpToFloat(slope_num[side] * len2 / slope_den[side] * (1 + 1e-12));
   for (std::size_t i = 0; i < count; ++i) {
     const Corner& c = *beyond[i];
     if (c.past[k] < 0.1 * len2) continue;
@@ -163,15 +163,15 @@ void FitRise(const Corner* const* beyond, std::size_t count, int k, double len2,
     }
   }
   for (int side = 0; side < 2; ++side) {
-    const double end = end_num[side] / end_den[side];
+    const double end = RoundUpToFloat(end_num[side] / end_den[side] * (1 + 1e-12));
     double base = 0;
     for (std::size_t i = 0; i < count; ++i) {
       const Corner& c = *beyond[i];
       base = std::max(base, c.rise[side] * len2 - slope[side] * c.inside[k] - end * c.past[k]);
     }
     out.base[side][k] = RoundUpToFloat(base * (1 + 1e-12));
-    out.slope[side][k] = RoundUpToFloat(slope[side] * (1 + 1e-12));
-    out.end[side][k] = RoundUpToFloat(end * (1 + 1e-12));
+    out.slope[side][k] = static_cast<float>(slope[side]);  // already a float
+    out.end[side][k] = static_cast<float>(end);
   }
 }
 
