@@ -1,12 +1,7 @@
 #include "core/distance/mesh_index.h"
 
-#include <algorithm>
-#include <chrono>
 #include <cmath>
-#include <limits>
-#include <new>
 
-#include "absl/strings/str_cat.h"
 #include "core/distance/hint_certificate.h"
 #include "core/distance/wide_bvh.h"
 
