@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/task_arena.h>
+#include <tbb/task_group.h>
 
 #include <chrono>
 #include <cstdio>
@@ -99,23 +100,23 @@ ErrorMapRun RemoteErrorMap(const ErrorMapArgs& a, const PointCloud& cloud_in_wor
   return run;
 }
 
-ErrorMapRun LocalErrorMap(const ErrorMapArgs& a, const PointCloud& cloud_in_world,
-                          const PointCloud& cloud_in_part, const Eigen::Isometry3d& world_from_part,
-                          TriangleMesh mesh, const MeshTopology& topo, const InspectionPlan& plan) {
+// In-process, the distances: the index on `mesh`, then the error map.
+std::unique_ptr<MeshIndex> LocalDistances(const ErrorMapArgs& a, const PointCloud& cloud_in_world,
+                                          const Eigen::Isometry3d& world_from_part,
+                                          TriangleMesh mesh, ErrorMapRun& run) {
   MeshIndexSettings build;
   build.build_threads = a.settings.threads;  // 0 = all cores, as for the queries
   build.hint_certificates = CertificatesPayOnce(cloud_in_world.size(), mesh.num_triangles());
-  const std::unique_ptr<MeshIndex> index = Take(MeshIndex::Build(std::move(mesh), build));
+  std::unique_ptr<MeshIndex> index = Take(MeshIndex::Build(std::move(mesh), build));
   spdlog::info(
-      "mesh index built in {:.3f} s ({} BVH nodes, {} search; {} boundary edges, {} degenerate "
-      "triangles; hint certificates {})",
+      "mesh index built in {:.3f} s ({} BVH nodes, {} search; {} degenerate triangles; hint "
+      "certificates {})",
       index->info().build_seconds, index->info().bvh_nodes, index->info().search_isa,
-      topo.boundary_edges, index->info().degenerate_triangles,
+      index->info().degenerate_triangles,
       build.hint_certificates
           ? fmt::format("for {} triangles in {:.3f} s", index->info().certifiable_triangles,
                         index->info().certificate_seconds)
           : fmt::format("off: fewer than {} points per triangle", kCertificatePointsPerTriangle));
-  ErrorMapRun run;
   run.build_seconds = index->info().build_seconds;
   run.result = Take(ComputeErrorMap(*index, cloud_in_world, world_from_part, a.settings));
   spdlog::info(
@@ -123,9 +124,17 @@ ErrorMapRun LocalErrorMap(const ErrorMapArgs& a, const PointCloud& cloud_in_worl
       "the hint alone)",
       run.result.stats.count, run.result.query_seconds, run.result.certified_points,
       run.result.hint_alone_points);
+  return index;
+}
+
+// In-process, after the distances: the plan's verdicts, the report and the
+// PNG. Reads run.result only, so the PLY may be written from it meanwhile.
+void LocalPlan(const ErrorMapArgs& a, const PointCloud& cloud_in_world,
+               const PointCloud& cloud_in_part, const MeshIndex& index, const InspectionPlan& plan,
+               ErrorMapRun& run) {
   auto t0 = std::chrono::steady_clock::now();
   const PlanOutcome outcome =
-      Take(EvaluatePlan(run.result, cloud_in_world, index->mesh(), plan, a.settings.threads));
+      Take(EvaluatePlan(run.result, cloud_in_world, index.mesh(), plan, a.settings.threads));
   run.plan_seconds = Seconds(t0);
   run.report = InspectionReportJson(run.result, a.settings, outcome);
   run.failed = client::FailedLines(outcome.characteristics);
@@ -137,10 +146,9 @@ ErrorMapRun LocalErrorMap(const ErrorMapArgs& a, const PointCloud& cloud_in_worl
     png.part_pass = outcome.pass();
     png.view_axis = a.png_axis == "x" ? 0 : a.png_axis == "y" ? 1 : a.png_axis == "z" ? 2 : -1;
     run.png_bytes = Take(EncodePng(
-        Take(RenderErrorMap(cloud_in_part, run.result, ComputeBounds(index->mesh()), png))));
+        Take(RenderErrorMap(cloud_in_part, run.result, ComputeBounds(index.mesh()), png))));
     run.png_seconds = Seconds(t0);
   }
-  return run;
 }
 
 void PrintSummary(const ErrorMapArgs& a, const ErrorMapRun& run) {
@@ -223,6 +231,56 @@ void RecordErrorMap(ResultsStore& store, const ErrorMapArgs& a, const PointCloud
               store.Name().c_str());
 }
 
+// The report's "mesh" block.
+nlohmann::json MeshJson(const TriangleMesh& mesh) {
+  const MeshTopology topo = AnalyzeTopology(mesh);
+  const std::size_t degenerate = mesh.CountDegenerate();
+  spdlog::info("mesh: {} boundary edges, {} non-manifold edges, {} degenerate triangles",
+               topo.boundary_edges, topo.nonmanifold_edges, degenerate);
+  return {{"triangles", mesh.num_triangles()},
+          {"boundary_edges", topo.boundary_edges},
+          {"nonmanifold_edges", topo.nonmanifold_edges},
+          {"degenerate_triangles", degenerate}};
+}
+
+// The error map, in-process or on the server, and the PLY: written as soon
+// as the deviations are known, its rows encoded, synced and renamed beside
+// the plan's evaluation, which only reads the same result. Returns the
+// PLY's write time, s.
+double ErrorMapAndPly(const ErrorMapArgs& a, const PointCloud& cloud_in_world,
+                      const PointCloud& cloud_in_part, const Eigen::Isometry3d& world_from_part,
+                      const TriangleMesh& mesh, const InspectionPlan& plan, ErrorMapRun& run) {
+  std::unique_ptr<MeshIndex> index;
+  if (a.remote.remote())
+    run = RemoteErrorMap(a, cloud_in_world, world_from_part, mesh, plan);
+  else
+    index = LocalDistances(a, cloud_in_world, world_from_part, mesh, run);
+  const PointCloud& written = a.frame == "world" ? cloud_in_world : cloud_in_part;
+  absl::Status ply;
+  double ply_seconds = 0;
+  tbb::task_group writing;
+  writing.run([&] {
+    const auto start = std::chrono::steady_clock::now();
+    try {
+      ply = WriteErrorMapPly(a.out, written, run.result, a.frame);
+    } catch (const std::bad_alloc&) {
+      ply = absl::ResourceExhaustedError("out of memory writing " + a.out);
+    }
+    ply_seconds = Seconds(start);
+  });
+  // A plan that fails waits for the writer first: a task group left by an
+  // exception cancels its tasks, and a cancelled encoding would leave rows out.
+  try {
+    if (index) LocalPlan(a, cloud_in_world, cloud_in_part, *index, plan, run);
+  } catch (...) {
+    writing.wait();
+    throw;
+  }
+  writing.wait();
+  Check(ply);
+  return ply_seconds;
+}
+
 void RunErrorMap(const ErrorMapArgs& a) {
   const std::unique_ptr<ResultsStore> store = a.db.empty() ? nullptr : OpenStore(a.db, false);
   auto t0 = std::chrono::steady_clock::now();
@@ -238,8 +296,7 @@ void RunErrorMap(const ErrorMapArgs& a) {
                                                 : Take(ReadTransformJson(a.world_from_part));
   const nlohmann::json plan_json =
       a.plan.empty() ? nlohmann::json() : Take(client::ReadPlanJson(a.plan));
-  auto mesh = Take(std::move(mesh_read));
-  const TriangleMesh mesh_to_record = store ? mesh : TriangleMesh();
+  const TriangleMesh mesh = Take(std::move(mesh_read));
   // A bad plan is refused before anything is measured.
   const InspectionPlan plan = a.plan.empty()
                                   ? PlanFromSettings(a.settings)
@@ -247,11 +304,10 @@ void RunErrorMap(const ErrorMapArgs& a) {
   const double read_seconds = Seconds(t0);
   spdlog::info("read {} points and {} triangles in {:.3f} s", cloud_in_world.size(),
                mesh.num_triangles(), read_seconds);
-  const MeshTopology topo = AnalyzeTopology(mesh);
-  const nlohmann::json mesh_json = {{"triangles", mesh.num_triangles()},
-                                    {"boundary_edges", topo.boundary_edges},
-                                    {"nonmanifold_edges", topo.nonmanifold_edges},
-                                    {"degenerate_triangles", mesh.CountDegenerate()}};
+  // Reported only: counted beside the index build, which takes a copy.
+  nlohmann::json mesh_json;
+  tbb::task_group counting;
+  counting.run([&] { mesh_json = MeshJson(mesh); });
   // Without --world-from-part the two frames are one: the same points,
   // without a copy of the cloud, when the copy would be bit-identical.
   const Eigen::Isometry3d part_from_world = world_from_part.inverse();
@@ -259,15 +315,13 @@ void RunErrorMap(const ErrorMapArgs& a) {
   if (!TransformKeepsCloud(cloud_in_world, part_from_world))
     moved = TransformCloud(cloud_in_world, part_from_world);
   const PointCloud& cloud_in_part = moved ? *moved : cloud_in_world;
-  const TriangleMesh html_mesh = a.html.empty() ? TriangleMesh() : mesh;  // the local path takes it
-  ErrorMapRun run = a.remote.remote()
-                        ? RemoteErrorMap(a, cloud_in_world, world_from_part, mesh, plan)
-                        : LocalErrorMap(a, cloud_in_world, cloud_in_part, world_from_part,
-                                        std::move(mesh), topo, plan);
+  ErrorMapRun run;
+  const double ply_seconds =
+      ErrorMapAndPly(a, cloud_in_world, cloud_in_part, world_from_part, mesh, plan, run);
+  counting.wait();
   // Files carry part-frame coordinates by default, so they overlay the CAD.
   const PointCloud& written = a.frame == "world" ? cloud_in_world : cloud_in_part;
   const auto t_write = std::chrono::steady_clock::now();
-  Check(WriteErrorMapPly(a.out, written, run.result, a.frame));
   if (!a.csv.empty()) Check(WriteErrorMapCsv(a.csv, written, run.result));
   if (!a.png.empty()) Check(WriteStringAtomically(a.png, run.png_bytes));
   if (!a.pdf.empty()) {
@@ -278,7 +332,7 @@ void RunErrorMap(const ErrorMapArgs& a) {
     pdf.deviation_mm = &run.result.deviation_mm;
     Check(WritePdfReport(a.pdf, pdf));
   }
-  if (!a.html.empty()) WriteHtml(a, run, cloud_in_part, html_mesh);
+  if (!a.html.empty()) WriteHtml(a, run, cloud_in_part, mesh);
   if (!a.qif.empty()) WriteQif(a, run, written.size());
   if (!a.report.empty()) {
     // The remote report's timing is the server's; the local one is all ours.
@@ -289,7 +343,7 @@ void RunErrorMap(const ErrorMapArgs& a) {
       timing["plan_seconds"] = run.plan_seconds;
       timing["png_seconds"] = run.png_seconds;
     }
-    timing["write_seconds"] = Seconds(t_write);
+    timing["write_seconds"] = ply_seconds + Seconds(t_write);
     timing["total_seconds"] = Seconds(t0);
     run.report["inputs"] = {
         {"cloud", a.cloud}, {"mesh", a.mesh}, {"world_from_part", a.world_from_part}};
@@ -298,8 +352,7 @@ void RunErrorMap(const ErrorMapArgs& a) {
     Check(WriteStringAtomically(a.report, run.report.dump(2) + "\n"));
   }
   PrintSummary(a, run);
-  if (store)
-    RecordErrorMap(*store, a, cloud_in_world, world_from_part, mesh_to_record, plan_json, run);
+  if (store) RecordErrorMap(*store, a, cloud_in_world, world_from_part, mesh, plan_json, run);
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "core/errormap/error_map.h"
 
+#include <tbb/parallel_invoke.h>
+
 #include <algorithm>
 #include <chrono>
 #include <new>
@@ -32,18 +34,8 @@ ComponentStats Summarize(const std::vector<T>& values) {
   return c;
 }
 
-// The summary, verdict and percentiles of the matched deviations. `cancel`
-// is polled between the passes (each O(n): ~20 ms on 5 M points); false
-// when it was set.
-bool ComputeStats(const ErrorMapSettings& settings, ErrorMapResult& r,
-                  const std::atomic<bool>* cancel) {
-  std::vector<float> matched;
-  matched.reserve(r.stats.matched);
-  for (float d : r.deviation_mm)
-    if (!std::isnan(d)) matched.push_back(d);
-  if (IsCancelled(cancel)) return false;
-  const double tol = settings.tolerance_mm;
-  Verdict& v = r.verdict;
+// The verdict's counts of the matched deviations against +-tol.
+void CountVerdict(const std::vector<float>& matched, double tol, Verdict& v) {
   for (float d : matched) {
     if (d > tol)
       ++v.above;
@@ -52,50 +44,52 @@ bool ComputeStats(const ErrorMapSettings& settings, ErrorMapResult& r,
     else
       ++v.within;
   }
-  if (!matched.empty()) {
-    // Two passes in double, in input order: deterministic to the last bit.
-    const ComponentStats s = Summarize(matched);
-    double var = 0;
-    for (const double d : matched) var += (d - s.mean_mm) * (d - s.mean_mm);
-    r.stats.min_mm = s.min_mm;
-    r.stats.max_mm = s.max_mm;
-    r.stats.mean_mm = s.mean_mm;
-    r.stats.rms_mm = s.rms_mm;
-    r.stats.stddev_mm = std::sqrt(var / matched.size());
-    if (IsCancelled(cancel)) return false;
-    const std::vector<double> p = FloatPercentiles(matched, {0.01, 0.05, 0.50, 0.95, 0.99});
-    r.stats.p1_mm = p[0];
-    r.stats.p5_mm = p[1];
-    r.stats.p50_mm = p[2];
-    r.stats.p95_mm = p[3];
-    r.stats.p99_mm = p[4];
-    v.fraction_within = static_cast<double>(v.within) / r.stats.matched;
-    v.fraction_outside = 1.0 - v.fraction_within;
-  }
-  v.pass = r.stats.matched > 0 && v.fraction_outside <= settings.allowed_fraction_outside;
-  if (r.stats.matched == 0) {
+}
+
+// Min, max, mean, rms and standard deviation of the matched deviations: two
+// passes in double, in input order, so deterministic to the last bit.
+void SummarizeMatched(const std::vector<float>& matched, ErrorMapStats& stats) {
+  if (matched.empty()) return;
+  const ComponentStats s = Summarize(matched);
+  double var = 0;
+  for (const double d : matched) var += (d - s.mean_mm) * (d - s.mean_mm);
+  stats.min_mm = s.min_mm;
+  stats.max_mm = s.max_mm;
+  stats.mean_mm = s.mean_mm;
+  stats.rms_mm = s.rms_mm;
+  stats.stddev_mm = std::sqrt(var / matched.size());
+}
+
+void SetPercentiles(const std::vector<float>& matched, ErrorMapStats& stats) {
+  if (matched.empty()) return;
+  const std::vector<double> p = FloatPercentiles(matched, {0.01, 0.05, 0.50, 0.95, 0.99});
+  stats.p1_mm = p[0];
+  stats.p5_mm = p[1];
+  stats.p50_mm = p[2];
+  stats.p95_mm = p[3];
+  stats.p99_mm = p[4];
+}
+
+void SetReason(const ErrorMapSettings& settings, const ErrorMapStats& stats, Verdict& v) {
+  if (stats.matched == 0) {
     v.reason =
         absl::StrCat("fail: no point within ", settings.max_distance_mm, " mm of the CAD surface");
-  } else {
-    v.reason = absl::StrFormat(
-        "%s: %.3f%% of %u matched points outside +-%.4g mm (%u above, %u below; allowed %.3f%%)",
-        v.pass ? "pass" : "fail", 100 * v.fraction_outside, r.stats.matched, tol, v.above, v.below,
-        100 * settings.allowed_fraction_outside);
+    return;
   }
+  v.reason = absl::StrFormat(
+      "%s: %.3f%% of %u matched points outside +-%.4g mm (%u above, %u below; allowed %.3f%%)",
+      v.pass ? "pass" : "fail", 100 * v.fraction_outside, stats.matched, settings.tolerance_mm,
+      v.above, v.below, 100 * settings.allowed_fraction_outside);
+}
 
-  if (IsCancelled(cancel)) return false;
-  const double range = settings.histogram_range_mm > 0
-                           ? settings.histogram_range_mm
-                           : AutoColorRange(tol, r.stats.p1_mm, r.stats.p99_mm);
-  r.color_range_mm = range;
-  Histogram& h = r.histogram;
+// The histogram of the matched deviations over +-range (the colour scale's).
+void FillHistogram(const std::vector<float>& matched, int bins, double range, Histogram& h) {
   h.min_mm = -range;
   h.max_mm = range;
-  h.counts.assign(static_cast<std::size_t>(settings.histogram_bins), 0);
-  const double per_mm = settings.histogram_bins / (2 * range);
+  h.counts.assign(static_cast<std::size_t>(bins), 0);
+  const double per_mm = bins / (2 * range);
   const double last_bin = double(h.counts.size() - 1);
-  for (float d : r.deviation_mm) {
-    if (std::isnan(d)) continue;
+  for (float d : matched) {
     if (d < -range)
       ++h.below_range;
     else if (d >= range)
@@ -103,6 +97,43 @@ bool ComputeStats(const ErrorMapSettings& settings, ErrorMapResult& r,
     else  // clamped in double first: a float-to-integer conversion out of range is undefined
       ++h.counts[static_cast<std::size_t>(std::min(last_bin, (d + range) * per_mm))];
   }
+}
+
+// The counts, summary, verdict, percentiles and histogram of the matched
+// deviations. The sums' order fixes their bits, so they stay one serial
+// pass; the counts of valid points, the verdict's counts and the
+// percentiles (which the histogram's range needs) run beside them. `cancel`
+// is polled between the steps; false when it was set.
+bool ComputeStats(const PointCloud& cloud, const ErrorMapSettings& settings, ErrorMapResult& r,
+                  const std::atomic<bool>* cancel) {
+  std::vector<float> matched;
+  matched.reserve(r.deviation_mm.size());
+  for (float d : r.deviation_mm)
+    if (!std::isnan(d)) matched.push_back(d);
+  r.stats.count = cloud.size();
+  r.stats.matched = matched.size();
+  if (IsCancelled(cancel)) return false;
+  Verdict& v = r.verdict;
+  tbb::parallel_invoke(
+      [&] {
+        r.stats.valid = cloud.CountValid();
+        SummarizeMatched(matched, r.stats);
+      },
+      [&] {
+        CountVerdict(matched, settings.tolerance_mm, v);
+        SetPercentiles(matched, r.stats);
+      });
+  if (!matched.empty()) {
+    v.fraction_within = static_cast<double>(v.within) / r.stats.matched;
+    v.fraction_outside = 1.0 - v.fraction_within;
+  }
+  v.pass = r.stats.matched > 0 && v.fraction_outside <= settings.allowed_fraction_outside;
+  SetReason(settings, r.stats, v);
+  if (IsCancelled(cancel)) return false;
+  r.color_range_mm = settings.histogram_range_mm > 0
+                         ? settings.histogram_range_mm
+                         : AutoColorRange(settings.tolerance_mm, r.stats.p1_mm, r.stats.p99_mm);
+  FillHistogram(matched, settings.histogram_bins, r.color_range_mm, r.histogram);
   return true;
 }
 
@@ -199,10 +230,7 @@ absl::StatusOr<ErrorMapResult> ComputeErrorMap(const MeshIndex& index,
   r.hint_alone_points = timing.hint_alone_points;
 
   if (IsCancelled(cancel)) return cancelled;
-  r.stats.count = n;
-  r.stats.valid = cloud_in_world.CountValid();
-  for (float d : r.deviation_mm) r.stats.matched += std::isnan(d) ? 0 : 1;
-  if (!ComputeStats(settings, r, cancel)) return cancelled;
+  if (!ComputeStats(cloud_in_world, settings, r, cancel)) return cancelled;
   if (split) {
     std::array<std::vector<double>, 4> comp;
     for (std::size_t i = 0; i < n; ++i) {
