@@ -46,51 +46,77 @@ struct GridScratch {
   UnionFind forest;           // over run indices
 };
 
-// The runs of the row above, runs[first..] in column order, walked left to
-// right: the columns asked for along one link direction never decrease in
-// a row, so each direction keeps a cursor and a row's lookups cost one pass
-// over the runs above (no per-column table to fill). `offset` turns an
-// index into runs into the forest's.
+// The runs of the row above, runs[first..] in column order, walked by a
+// cursor: the columns a row's runs link to rise along the row, except that
+// a run's north-west link may reach one or two columns left of where the
+// run before it ended (its north-east link), so the cursor also steps back.
+// A row's lookups cost about one pass over the runs above (no per-column
+// table to fill). `offset` turns an index into runs into the forest's.
 struct RowAbove {
   const std::vector<Run>& runs;
-  std::size_t cursor[3];
+  std::size_t cursor;
   int32_t offset;
   RowAbove(const std::vector<Run>& r, std::size_t first, int32_t off)
-      : runs(r), cursor{first, first, first}, offset(off) {}
-  // The run holding column `col`, which must be valid, along direction k.
-  std::size_t RunAt(int k, uint32_t col) {
-    std::size_t& at = cursor[k];
-    while (runs[at].last_col < col) ++at;
-    return at;
+      : runs(r), cursor(first), offset(off) {}
+  // The run holding column `col`, which must be valid.
+  std::size_t RunAt(uint32_t col) {
+    while (runs[cursor].last_col < col) ++cursor;
+    while (runs[cursor].first_col > col) --cursor;
+    return cursor;
   }
 };
 
+// Bits of mask word k that lie in columns s..e.
+uint64_t InColumns(uint32_t k, uint32_t s, uint32_t e) {
+  if (k < s / 64 || k > e / 64) return 0;
+  const uint64_t from = k == s / 64 ? ~uint64_t{0} << (s % 64) : ~uint64_t{0};
+  const uint64_t to = k == e / 64 ? ~uint64_t{0} >> (63 - e % 64) : ~uint64_t{0};
+  return from & to;
+}
+
+// Word k of the columns above that pixels s..e link to: north at the same
+// column, north-west one to the left, north-east one to the right (the
+// diagonals' bits carried across words).
+uint64_t LinkedAbove(const uint64_t* const vertical[3], uint32_t k, uint32_t s, uint32_t e,
+                     bool eight) {
+  uint64_t above = vertical[1][k] & InColumns(k, s, e);
+  if (!eight) return above;
+  above |= (vertical[0][k] & InColumns(k, s, e)) >> 1;
+  above |= (vertical[2][k] & InColumns(k, s, e)) << 1;
+  if (const uint64_t next = InColumns(k + 1, s, e)) above |= (vertical[0][k + 1] & next) << 63;
+  if (k > 0)
+    if (const uint64_t prev = InColumns(k - 1, s, e)) above |= (vertical[2][k - 1] & prev) >> 63;
+  return above;
+}
+
 // Merges run `id` (columns s..e of its row) with every run above that one
 // of its pixels links to along the row's north-west, north and north-east
-// masks.
+// masks: the three directions as one mask of the columns above, so each
+// linked run above is found, and merged, once.
 void MergeWithRunsAbove(const uint64_t* const vertical[3], int32_t id, uint32_t s, uint32_t e,
                         uint32_t width, bool eight, RowAbove& above, UnionFind& forest) {
   // Most runs are a single outlier pixel, linked to nothing above: one test.
   if (s / 64 == e / 64) {
     const uint32_t k = s / 64;
-    const uint64_t in_run = (~uint64_t{0} >> (63 - e % 64)) & (~uint64_t{0} << (s % 64));
+    const uint64_t in_run = InColumns(k, s, e);
     const uint64_t up = vertical[1][k] | (eight ? vertical[0][k] | vertical[2][k] : 0);
     if ((up & in_run) == 0) return;
   }
-  const int offsets[3] = {-1, 0, 1};  // north-west, north, north-east
-  const bool use[3] = {eight, true, eight};
-  for (int k = 0; k < 3; ++k) {
-    if (!use[k]) continue;
-    // All pixels up to the end of a run above (shifted by the offset)
-    // reach that same run: merge once, then skip past it.
-    for (uint32_t c = NextBitUpTo(vertical[k], s, e); c != kNone;
-         c = NextBitUpTo(vertical[k], c, e)) {
-      const std::size_t run_up = above.RunAt(k, c + offsets[k]);
-      forest.Union(id, static_cast<int32_t>(run_up) + above.offset);
-      const int64_t past = int64_t{above.runs[run_up].last_col} - offsets[k] + 1;
-      c = static_cast<uint32_t>(std::max<int64_t>(c + 1, past));
-      if (c >= width) break;
+  // The columns above that can be linked: one beyond each end with the diagonals.
+  const uint32_t last = eight && e + 1 < width ? e + 1 : e;
+  uint32_t from = eight && s > 0 ? s - 1 : s;  // the first column above still to look at
+  while (from <= last) {
+    const uint32_t k = from / 64;
+    const uint64_t bits = LinkedAbove(vertical, k, s, e, eight) & (~uint64_t{0} << (from % 64));
+    if (bits == 0) {
+      from = 64 * (k + 1);
+      continue;
     }
+    const uint32_t c = 64 * k + static_cast<uint32_t>(__builtin_ctzll(bits));
+    const std::size_t run_up = above.RunAt(c);
+    forest.Union(id, static_cast<int32_t>(run_up) + above.offset);
+    // Every column up to the end of that run reaches the same run.
+    from = above.runs[run_up].last_col + 1;
   }
 }
 

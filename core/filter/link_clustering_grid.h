@@ -7,10 +7,11 @@
 // row is transposed to structure-of-arrays and its link tests (west,
 // north-west, north, north-east) become 64-bit masks, 4 pixels per SSE2
 // instruction (8 with AVX2 where the CPU has it). A run is a maximal chain
-// of west-linked pixels; runs are the union-find elements, and the north
-// links of a run are visited once per touching run above (bit scans skip
-// the rest; a cursor per direction walks the runs above), so the per-pixel
-// work is a handful of vector instructions. Bands of 64 rows are labelled
+// of west-linked pixels; runs are the union-find elements, and a run's
+// north-west, north and north-east links become one mask of the columns
+// above it links to, visited once per touching run above (bit scans skip
+// the rest; a cursor walks the runs above), so the per-pixel work is a
+// handful of vector instructions. Bands of 64 rows are labelled
 // in parallel and joined where each band's first row meets the row above
 // it; the union makes the smaller run the root, so the forest is the serial
 // pass's (grid_bands.h). The second pass numbers the components in raster
