@@ -129,18 +129,11 @@ absl::Status LabelRow(const PointCloud& cloud, uint32_t r, uint32_t band_first, 
   const uint32_t w = cloud.width, h = cloud.height;
   RowSoA& cur = g.rows[r & 1];
   const RowSoA& up = g.rows[(r + 1) & 1];
-  link_row::Transpose(&cloud.points[std::size_t{r} * w], w, cur, g.isa);
-  if (r + 1 < h && g.isa != link_row::RowIsa::kAvx512) {
-    // The next row streams in while this one is labelled: without it the
-    // transpose is bound by load latency on an AMD EPYC (AVX2, measured).
-    // On an Intel Xeon with AVX-512 the hardware prefetcher keeps up, and
-    // these prefetches cost 3% of the pass (measured).
-    const char* next = reinterpret_cast<const char*>(&cloud.points[std::size_t{r + 1} * w]);
-    for (std::size_t b = 0; b < std::size_t{w} * sizeof(Eigen::Vector3f); b += 64)
-      __builtin_prefetch(next + b);
-  }
   const bool above = r > 0;
-  if (link_row::ComputeMasks(cur, above ? &up : nullptr, eight, g.words, r2, g.m(), g.isa))
+  const Eigen::Vector3f* next = r + 1 < h ? &cloud.points[std::size_t{r + 1} * w] : nullptr;
+  if (link_row::TransposeAndComputeMasks(&cloud.points[std::size_t{r} * w], w, cur,
+                                         above ? &up : nullptr, eight, g.words, r2, g.m(), g.isa,
+                                         next))
     return absl::InvalidArgumentError(
         absl::StrCat("link clustering: row ", r, " holds an infinite coordinate"));
   const RowMasks m = g.m();

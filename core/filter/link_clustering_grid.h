@@ -6,7 +6,8 @@
 // two-scan labeling algorithm", IEEE TIP 2008) with 3D-distance links. Each
 // row is transposed to structure-of-arrays and its link tests (west,
 // north-west, north, north-east) become 64-bit masks, 4 pixels per SSE2
-// instruction (8 with AVX2 where the CPU has it). A run is a maximal chain
+// instruction (8 with AVX2 and 16 with AVX-512 where the CPU has them; with
+// AVX-512 in the same loop as the transpose). A run is a maximal chain
 // of west-linked pixels; runs are the union-find elements, and a run's
 // north-west, north and north-east links become one mask of the columns
 // above it links to, visited once per touching run above (bit scans skip

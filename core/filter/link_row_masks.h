@@ -52,6 +52,17 @@ void Transpose(const Eigen::Vector3f* pts, uint32_t w, RowSoA& row, RowIsa isa =
 bool ComputeMasks(const RowSoA& cur, const RowSoA* up, bool diagonals, uint32_t words,
                   float link_distance_sq, const RowMasks& masks, RowIsa isa = RowIsa::kAuto);
 
+// Transpose, then ComputeMasks, with the same results; with AVX-512 in one
+// pass that takes each group of 16 points from registers instead of
+// storing and loading it again (a 1024x768 scan's rows alone on one core:
+// 0.74 -> 0.51 ms; the whole grid pass gains 3-4%, its loads of the scan
+// being the rest). `next`, when given, is the next row's w points,
+// prefetched where that helps. `isa` must be supported.
+bool TransposeAndComputeMasks(const Eigen::Vector3f* pts, uint32_t w, RowSoA& cur, const RowSoA* up,
+                              bool diagonals, uint32_t words, float link_distance_sq,
+                              const RowMasks& masks, RowIsa isa = RowIsa::kAuto,
+                              const Eigen::Vector3f* next = nullptr);
+
 // Run starts (valid, not west-linked) and ends (valid, the next pixel not
 // west-linked) of a row, from its valid and west masks.
 void RunBounds(const RowMasks& m, uint32_t words, uint64_t* starts, uint64_t* ends);

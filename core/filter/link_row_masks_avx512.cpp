@@ -13,6 +13,15 @@ struct Avx512 {
   using Vec = __m512;
   static constexpr int kWidth = 16;
   static Vec Load(const float* p) { return _mm512_loadu_ps(p); }
+  static void Store(float* p, Vec v) { _mm512_storeu_ps(p, v); }
+  static void Transpose(const float* points, Vec& x, Vec& y, Vec& z) {
+    surfinspect::avx512::Transpose16(points, x, y, z);
+  }
+  // before's lane 15, then v's lanes 0-14: each lane's west neighbour.
+  static Vec ShiftIn(Vec v, Vec before) {
+    return _mm512_castsi512_ps(
+        _mm512_alignr_epi32(_mm512_castps_si512(v), _mm512_castps_si512(before), 15));
+  }
   static Vec Set1(float v) { return _mm512_set1_ps(v); }
   static Vec Sub(Vec a, Vec b) { return _mm512_sub_ps(a, b); }
   static Vec Mul(Vec a, Vec b) { return _mm512_mul_ps(a, b); }
@@ -45,6 +54,13 @@ float Reduce(__m512 v) {
 bool RowBits(const float* const cur[3], const float* const up[3], bool diagonals, uint32_t words,
              float link_distance_sq, uint64_t* const masks[5]) {
   return RowBitsOf<Avx512>(cur, up, diagonals, words, link_distance_sq, masks);
+}
+
+bool TransposedRowBits(const float* points, uint32_t whole, float* const cur[3],
+                       const float* const up[3], bool diagonals, uint32_t words,
+                       float link_distance_sq, uint64_t* const masks[5]) {
+  return TransposedRowBitsOf<Avx512>(points, whole, cur, up, diagonals, words, link_distance_sq,
+                                     masks);
 }
 
 uint32_t Transpose(const float* f, uint32_t w, float* x, float* y, float* z) {

@@ -164,6 +164,59 @@ TEST_P(LinkRowMasks, TransposeCopiesEveryCoordinate) {
   }
 }
 
+// The one-pass transpose and masks (AVX-512: groups of 16 from registers,
+// the west neighbour shifted in, the partial group read back) against the
+// two steps in SSE2, plane bits and every mask: widths on and off 16 and
+// 64, blocks without data, with and without the row above and diagonals.
+TEST_P(LinkRowMasks, TransposeAndComputeMasksEqualsItsTwoSteps) {
+  std::mt19937 rng(12);
+  std::uniform_int_distribution<int> lattice(-4, 4);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  const float r2 = LinkDistanceSquared(0.625f);
+  int links = 0;
+  for (uint32_t w : {1u, 15u, 16u, 17u, 63u, 64u, 65u, 100u, 130u, 1024u})
+    for (int trial = 0; trial < 8; ++trial) {
+      const uint32_t words = (w + 63) / 64;
+      std::vector<Eigen::Vector3f> up_pts(w), cur_pts(w);
+      for (auto* row : {&up_pts, &cur_pts})
+        for (uint32_t c = 0; c < w; ++c) {
+          const bool hole = u(rng) < 0.1f || (c / 16) % 5 == 3;  // and whole blocks
+          (*row)[c] = hole ? Eigen::Vector3f(NAN, NAN, NAN)
+                           : Eigen::Vector3f(0.375f * c, row == &up_pts ? 0.f : 0.375f,
+                                             0.125f * lattice(rng));
+        }
+      const bool above = trial % 4 != 0, diagonals = trial % 2 == 1;
+      RowSoA up(64 * words), want(64 * words), got(64 * words);
+      std::vector<uint64_t> want_bits(5 * words, 7), got_bits(5 * words, 9);
+      auto masks = [&](std::vector<uint64_t>& b) {
+        return RowMasks{&b[0], &b[words], &b[2 * words], &b[3 * words], &b[4 * words]};
+      };
+      Transpose(up_pts.data(), w, up, RowIsa::kSse2);
+      Transpose(cur_pts.data(), w, want, RowIsa::kSse2);
+      ASSERT_FALSE(ComputeMasks(want, above ? &up : nullptr, diagonals, words, r2, masks(want_bits),
+                                RowIsa::kSse2));
+      ASSERT_FALSE(TransposeAndComputeMasks(cur_pts.data(), w, got, above ? &up : nullptr,
+                                            diagonals, words, r2, masks(got_bits), GetParam(),
+                                            up_pts.data()));
+      for (int a = 0; a < 3; ++a)
+        ASSERT_EQ(std::memcmp(want.c(a) - 1, got.c(a) - 1, (64 * words + 2) * sizeof(float)), 0)
+            << "w " << w << " axis " << a;
+      ASSERT_EQ(want_bits, got_bits) << "w " << w << " trial " << trial;
+      for (uint32_t k = words; k < 5 * words; ++k) links += __builtin_popcountll(got_bits[k]);
+    }
+  EXPECT_GT(links, 1000);  // links of every kind are exercised
+  // An infinite coordinate is reported, wherever it falls.
+  for (uint32_t at : {0u, 15u, 16u, 40u}) {
+    std::vector<Eigen::Vector3f> pts(50, Eigen::Vector3f(1.f, 2.f, 3.f));
+    pts[at].y() = INFINITY;
+    RowSoA row(64);
+    std::vector<uint64_t> bits(5);
+    const RowMasks m{&bits[0], &bits[1], &bits[2], &bits[3], &bits[4]};
+    EXPECT_TRUE(TransposeAndComputeMasks(pts.data(), 50, row, nullptr, true, 1, r2, m, GetParam()))
+        << at;
+  }
+}
+
 // Starts and ends against their per-pixel definitions, across words, and
 // the bit scan against a linear search.
 TEST(LinkRowRuns, StartsEndsAndNextBitMatchTheirDefinitions) {
