@@ -13,7 +13,6 @@ namespace {
 
 using link_row::kNone;
 using link_row::NextBit;
-using link_row::NextBitUpTo;
 using link_row::RowMasks;
 using link_row::RowSoA;
 
@@ -79,10 +78,11 @@ uint64_t InColumns(uint32_t k, uint32_t s, uint32_t e) {
 // diagonals' bits carried across words).
 uint64_t LinkedAbove(const uint64_t* const vertical[3], uint32_t k, uint32_t s, uint32_t e,
                      bool eight) {
-  uint64_t above = vertical[1][k] & InColumns(k, s, e);
+  const uint64_t in_run = InColumns(k, s, e);
+  uint64_t above = vertical[1][k] & in_run;
   if (!eight) return above;
-  above |= (vertical[0][k] & InColumns(k, s, e)) >> 1;
-  above |= (vertical[2][k] & InColumns(k, s, e)) << 1;
+  above |= (vertical[0][k] & in_run) >> 1;
+  above |= (vertical[2][k] & in_run) << 1;
   if (const uint64_t next = InColumns(k + 1, s, e)) above |= (vertical[0][k + 1] & next) << 63;
   if (k > 0)
     if (const uint64_t prev = InColumns(k - 1, s, e)) above |= (vertical[2][k - 1] & prev) >> 63;
