@@ -64,6 +64,7 @@ double Number(const nlohmann::json& j, const char* key) {
 struct ErrorMapRun {
   ErrorMapResult result;
   nlohmann::json report;
+  nlohmann::json mesh;  // the report's "mesh" block
   std::string png_bytes;
   std::vector<std::string> failed, defects;  // for the summary
   // Stage times, s, merged into the report's "timing" block.
@@ -100,6 +101,16 @@ ErrorMapRun RemoteErrorMap(const ErrorMapArgs& a, const PointCloud& cloud_in_wor
   return run;
 }
 
+// The report's "mesh" block.
+nlohmann::json MeshJson(std::size_t triangles, const MeshTopology& topo, std::size_t degenerate) {
+  spdlog::info("mesh: {} boundary edges, {} non-manifold edges, {} degenerate triangles",
+               topo.boundary_edges, topo.nonmanifold_edges, degenerate);
+  return {{"triangles", triangles},
+          {"boundary_edges", topo.boundary_edges},
+          {"nonmanifold_edges", topo.nonmanifold_edges},
+          {"degenerate_triangles", degenerate}};
+}
+
 // In-process, the distances: the index on `mesh`, then the error map.
 std::unique_ptr<MeshIndex> LocalDistances(const ErrorMapArgs& a, const PointCloud& cloud_in_world,
                                           const Eigen::Isometry3d& world_from_part,
@@ -118,6 +129,8 @@ std::unique_ptr<MeshIndex> LocalDistances(const ErrorMapArgs& a, const PointClou
                         index->info().certificate_seconds)
           : fmt::format("off: fewer than {} points per triangle", kCertificatePointsPerTriangle));
   run.build_seconds = index->info().build_seconds;
+  run.mesh = MeshJson(index->mesh().num_triangles(), index->Topology(),
+                      index->info().degenerate_triangles);
   run.result = Take(ComputeErrorMap(*index, cloud_in_world, world_from_part, a.settings));
   spdlog::info(
       "distances for {} points in {:.3f} s ({} answered by hint certificates, {} by "
@@ -231,18 +244,6 @@ void RecordErrorMap(ResultsStore& store, const ErrorMapArgs& a, const PointCloud
               store.Name().c_str());
 }
 
-// The report's "mesh" block.
-nlohmann::json MeshJson(const TriangleMesh& mesh) {
-  const MeshTopology topo = AnalyzeTopology(mesh);
-  const std::size_t degenerate = mesh.CountDegenerate();
-  spdlog::info("mesh: {} boundary edges, {} non-manifold edges, {} degenerate triangles",
-               topo.boundary_edges, topo.nonmanifold_edges, degenerate);
-  return {{"triangles", mesh.num_triangles()},
-          {"boundary_edges", topo.boundary_edges},
-          {"nonmanifold_edges", topo.nonmanifold_edges},
-          {"degenerate_triangles", degenerate}};
-}
-
 // The error map, in-process or on the server, and the PLY: written as soon
 // as the deviations are known, its rows encoded, synced and renamed beside
 // the plan's evaluation, which only reads the same result. Returns the
@@ -304,10 +305,14 @@ void RunErrorMap(const ErrorMapArgs& a) {
   const double read_seconds = Seconds(t0);
   spdlog::info("read {} points and {} triangles in {:.3f} s", cloud_in_world.size(),
                mesh.num_triangles(), read_seconds);
-  // Reported only: counted beside the index build, which takes a copy.
+  // Reported only. In-process, the index build counts them; for the
+  // server, they are counted here meanwhile.
   nlohmann::json mesh_json;
   tbb::task_group counting;
-  counting.run([&] { mesh_json = MeshJson(mesh); });
+  if (a.remote.remote())
+    counting.run([&] {
+      mesh_json = MeshJson(mesh.num_triangles(), AnalyzeTopology(mesh), mesh.CountDegenerate());
+    });
   // Without --world-from-part the two frames are one: the same points,
   // without a copy of the cloud, when the copy would be bit-identical.
   const Eigen::Isometry3d part_from_world = world_from_part.inverse();
@@ -319,6 +324,7 @@ void RunErrorMap(const ErrorMapArgs& a) {
   const double ply_seconds =
       ErrorMapAndPly(a, cloud_in_world, cloud_in_part, world_from_part, mesh, plan, run);
   counting.wait();
+  if (!a.remote.remote()) mesh_json = std::move(run.mesh);
   // Files carry part-frame coordinates by default, so they overlay the CAD.
   const PointCloud& written = a.frame == "world" ? cloud_in_world : cloud_in_part;
   const auto t_write = std::chrono::steady_clock::now();

@@ -129,6 +129,10 @@ class MeshIndex {
 
   const TriangleMesh& mesh() const { return mesh_; }
   const MeshIndexInfo& info() const { return info_; }
+  // AnalyzeTopology(mesh()). The build counted the same edges on the welded
+  // vertices, so its counts are taken when no vertex was welded; a mesh
+  // that repeats positions is counted again on its own indices.
+  MeshTopology Topology() const;
   // The BVH and the hint certificates (null when off), for their tests.
   // Both number the triangles by their position in the index's order
   // (core/distance/mesh_order.h), not by mesh id.

@@ -1,8 +1,11 @@
 // MeshIndex::Build (declared in mesh_index.h): face normals, the spatial
 // order, Embree's BVH beside the pseudonormals, then the hint certificates.
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <chrono>
 #include <new>
 
@@ -26,7 +29,6 @@ absl::StatusOr<std::unique_ptr<MeshIndex>> MeshIndex::Build(TriangleMesh mesh,
   const auto start = std::chrono::steady_clock::now();
   std::unique_ptr<MeshIndex> index(new MeshIndex());
   index->mesh_ = std::move(mesh);
-  index->ComputeFaceNormals();
   auto device = EmbreeDevice::Create();
   if (!device.ok()) return device.status();
   // Embree builds with TBB; an arena bounds the build's threads without a
@@ -36,6 +38,7 @@ absl::StatusOr<std::unique_ptr<MeshIndex>> MeshIndex::Build(TriangleMesh mesh,
   absl::StatusOr<WideBvh> bvh;
   arena.execute([&] {
     try {
+      index->ComputeFaceNormals();
       bvh = index->BuildInOrder((*device)->get(), settings);
     } catch (const std::bad_alloc&) {
       bvh = absl::ResourceExhaustedError(
@@ -118,25 +121,28 @@ absl::Status MeshIndex::BuildCertificates(const MeshIndexSettings& settings) {
 }
 
 // The face normals and kernel shapes, which the BVH needs; the edge and
-// vertex pseudonormals below are built beside it.
+// vertex pseudonormals below are built beside it. Each triangle's are its
+// own, so they are computed in parallel.
 void MeshIndex::ComputeFaceNormals() {
   const auto& verts = mesh_.vertices;
   const auto& tris = mesh_.triangles;
-  face_normal_.assign(tris.size(), Eigen::Vector3d::Zero());
+  face_normal_.resize(tris.size());
   shape_.resize(tris.size());
-  for (std::size_t t = 0; t < tris.size(); ++t) {
-    // The kernel's degeneracy test is TriangleMesh::IsDegenerate's.
-    shape_[t] = ClassifyTriangle(verts[tris[t][0]].cast<double>(), verts[tris[t][1]].cast<double>(),
-                                 verts[tris[t][2]].cast<double>());
-    if (shape_[t] == TriangleShape::kDegenerate) {
-      ++info_.degenerate_triangles;
-      continue;  // a zero normal: contributes nothing to its neighbours' sums
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tris.size(), 4096), [&](const auto& range) {
+    for (std::size_t t = range.begin(); t != range.end(); ++t) {
+      const Eigen::Vector3d a = verts[tris[t][0]].cast<double>(),
+                            b = verts[tris[t][1]].cast<double>(),
+                            c = verts[tris[t][2]].cast<double>();
+      // The kernel's degeneracy test is TriangleMesh::IsDegenerate's. A
+      // degenerate triangle's zero normal adds nothing to its neighbours' sums.
+      shape_[t] = ClassifyTriangle(a, b, c);
+      face_normal_[t] = shape_[t] == TriangleShape::kDegenerate
+                            ? Eigen::Vector3d::Zero()
+                            : Eigen::Vector3d((b - a).cross(c - a).normalized());
     }
-    const Eigen::Vector3d a = verts[tris[t][0]].cast<double>(),
-                          b = verts[tris[t][1]].cast<double>(),
-                          c = verts[tris[t][2]].cast<double>();
-    face_normal_[t] = (b - a).cross(c - a).normalized();
-  }
+  });
+  info_.degenerate_triangles = static_cast<std::size_t>(
+      std::count(shape_.begin(), shape_.end(), TriangleShape::kDegenerate));
 }
 
 // Moves the per-triangle and per-vertex data, computed in the mesh's

@@ -80,4 +80,12 @@ void MeshIndex::ComputeFeatureNormals() {
     if (n.norm() > 0) n.normalize();
 }
 
+MeshTopology MeshIndex::Topology() const {
+  if (info_.welded_vertices > 0) return AnalyzeTopology(mesh_);
+  MeshTopology topo;
+  topo.boundary_edges = info_.boundary_edges;
+  topo.nonmanifold_edges = info_.nonmanifold_edges;
+  return topo;
+}
+
 }  // namespace surfinspect

@@ -28,12 +28,18 @@ std::string TempPathFor(const std::string& path) {
   return absl::StrCat(stem, ".tmp-", ::getpid(), "-", counter++, ext);
 }
 
-void SyncFile(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY);
-  if (fd >= 0) {
-    ::fsync(fd);
-    ::close(fd);
-  }
+// The temporary file's data and size on disk before the rename, so that a
+// crash never leaves the target name on a file without its content.
+// EINVAL: the filesystem cannot sync (nothing to wait for).
+absl::Status SyncFile(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return absl::OkStatus();  // the writer made it: reported by the rename if gone
+  const bool synced = ::fsync(fd) == 0 || errno == EINVAL;
+  const int error = errno;
+  ::close(fd);
+  if (!synced)
+    return absl::DataLossError(absl::StrCat("cannot sync ", path, ": ", std::strerror(error)));
+  return absl::OkStatus();
 }
 
 }  // namespace
@@ -43,12 +49,10 @@ absl::Status WriteFileAtomically(
     const std::function<absl::Status(const std::string& tmp_path)>& write_to) {
   const std::string tmp = TempPathFor(path);
   absl::Status st = write_to(tmp);
-  if (st.ok()) {
-    SyncFile(tmp);
-    if (std::rename(tmp.c_str(), path.c_str()) != 0)
-      st = absl::InternalError(
-          absl::StrCat("cannot rename ", tmp, " to ", path, ": ", std::strerror(errno)));
-  }
+  if (st.ok()) st = SyncFile(tmp);
+  if (st.ok() && std::rename(tmp.c_str(), path.c_str()) != 0)
+    st = absl::InternalError(
+        absl::StrCat("cannot rename ", tmp, " to ", path, ": ", std::strerror(errno)));
   if (!st.ok()) std::remove(tmp.c_str());
   return st;
 }

@@ -51,7 +51,10 @@ absl::Status TriangleMesh::Validate() const {
       if (v >= vertices.size())
         return absl::InvalidArgumentError(absl::StrCat("mesh: triangle ", t, " refers to vertex ",
                                                        v, " but there are only ", vertices.size()));
-  if (CountDegenerate() == triangles.size())
+  // One triangle with an area is enough; a count would classify them all.
+  bool any_regular = false;
+  for (std::size_t t = 0; t < triangles.size() && !any_regular; ++t) any_regular = !IsDegenerate(t);
+  if (!any_regular)
     return absl::InvalidArgumentError(
         absl::StrCat("mesh: all ", triangles.size(), " triangles are degenerate"));
   return absl::OkStatus();

@@ -512,6 +512,34 @@ TEST(MeshIndex, DegenerateAndNonManifoldTrianglesDoNotBreakQueries) {
   }
 }
 
+TEST(MeshIndex, TopologyAndDegenerateCountAreTheMeshCounts) {
+  // An open sheet with a fin (a non-manifold edge), a sliver and a point
+  // triangle; the same mesh as a soup, whose unwelded edges are all boundary.
+  TriangleMesh m = testing::HeightField(
+      0, 10, 0, 10, 11, 11, [](double x, double y) { return 0.3 * std::sin(x) * std::cos(y); });
+  const auto n = static_cast<uint32_t>(m.vertices.size());
+  m.vertices.emplace_back(5, 5, 3);
+  m.triangles.push_back({0, 1, 2});
+  m.triangles.push_back({n, n, n});
+  m.triangles.push_back({12, 13, n});
+  TriangleMesh soup;
+  for (const auto& t : m.triangles) {
+    const auto b = static_cast<uint32_t>(soup.vertices.size());
+    for (uint32_t v : t) soup.vertices.push_back(m.vertices[v]);
+    soup.triangles.push_back({b, b + 1, b + 2});
+  }
+  for (const TriangleMesh* mesh : {&m, &soup}) {
+    auto index = BuildOrDie(*mesh);
+    ASSERT_TRUE(index);
+    const MeshTopology want = AnalyzeTopology(*mesh);
+    EXPECT_EQ(index->Topology().boundary_edges, want.boundary_edges);
+    EXPECT_EQ(index->Topology().nonmanifold_edges, want.nonmanifold_edges);
+    EXPECT_EQ(index->info().degenerate_triangles, mesh->CountDegenerate());
+  }
+  EXPECT_EQ(AnalyzeTopology(soup).boundary_edges, 3 * soup.triangles.size());
+  EXPECT_GE(AnalyzeTopology(m).nonmanifold_edges, 1u);
+}
+
 TEST(MeshIndex, BuildRejectsBadMeshesAndSettings) {
   EXPECT_EQ(MeshIndex::Build(TriangleMesh{}).status().code(), absl::StatusCode::kInvalidArgument);
   TriangleMesh nan = testing::Box(Vector3d::Zero(), Vector3d::Ones());
