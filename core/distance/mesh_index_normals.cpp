@@ -6,10 +6,42 @@
 
 #include "core/distance/mesh_index.h"
 #include "core/types/first_equal_point.h"
-#include "core/types/radix_sort.h"
 
 namespace surfinspect {
 namespace {
+
+// The corner slots t * 3 + k of `tris`, each naming the edge from its corner
+// to the next, sorted by the edge's welded vertex pair (u, w), u < w, with
+// equal pairs in slot order (a stable sort by u * n + w). Counted into one
+// bucket per u, slot by slot, then each bucket (a vertex's few edges) put
+// in w order by insertion, which keeps equal pairs in slot order: about a
+// quarter of a radix sort's time on the 64-bit keys. `keys` gets u * n + w.
+void SortEdgeSlots(const std::vector<Triangle>& tris, const std::vector<uint32_t>& weld,
+                   std::vector<uint64_t>& keys, std::vector<uint32_t>& slots) {
+  const std::size_t n = weld.size(), m = tris.size() * 3;
+  std::vector<uint32_t> low(m), high(m), start(n + 1, 0);
+  for (std::size_t t = 0; t < tris.size(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      uint32_t u = weld[tris[t][k]], w = weld[tris[t][(k + 1) % 3]];
+      if (u > w) std::swap(u, w);
+      low[t * 3 + k] = u;
+      high[t * 3 + k] = w;
+      ++start[u + 1];
+    }
+  for (std::size_t v = 0; v < n; ++v) start[v + 1] += start[v];
+  std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+  slots.resize(m);
+  keys.resize(m);
+  for (std::size_t i = 0; i < m; ++i) slots[fill[low[i]]++] = static_cast<uint32_t>(i);
+  for (std::size_t v = 0; v < n; ++v)
+    for (uint32_t j = start[v] + 1; j < start[v + 1]; ++j) {
+      const uint32_t slot = slots[j];
+      uint32_t i = j;
+      for (; i > start[v] && high[slots[i - 1]] > high[slot]; --i) slots[i] = slots[i - 1];
+      slots[i] = slot;
+    }
+  for (std::size_t i = 0; i < m; ++i) keys[i] = uint64_t{low[slots[i]]} * n + high[slots[i]];
+}
 
 // Interior angle at `v` between the edges to `u` and `w` (radians).
 double Angle(const Eigen::Vector3d& v, const Eigen::Vector3d& u, const Eigen::Vector3d& w) {
@@ -32,23 +64,11 @@ void MeshIndex::ComputeFeatureNormals() {
     info_.welded_vertices += weld_[i] != i;
   }
 
-  // Edges: a stable sort of the slots t * 3 + k by welded vertex pair (u <
-  // w, keyed u * n + w), then the face normals summed per run in slot order.
-  const uint64_t n = verts.size();
+  // Edges: the slots t * 3 + k sorted by welded vertex pair, then the face
+  // normals summed per run in slot order.
   std::vector<uint64_t> keys;
   std::vector<uint32_t> slots;
-  keys.reserve(tris.size() * 3);
-  slots.reserve(tris.size() * 3);
-  for (std::size_t t = 0; t < tris.size(); ++t)
-    for (int k = 0; k < 3; ++k) {
-      uint32_t u = weld_[tris[t][k]], w = weld_[tris[t][(k + 1) % 3]];
-      if (u > w) std::swap(u, w);
-      keys.push_back(u * n + w);
-      slots.push_back(static_cast<uint32_t>(t * 3 + k));
-    }
-  int key_bits = 1;
-  while (key_bits < 64 && (n * n - 1) >> key_bits) ++key_bits;
-  RadixSortPairs(keys, slots, key_bits);
+  SortEdgeSlots(tris, weld_, keys, slots);
   triangle_edges_.resize(tris.size());
   edge_normal_.clear();
   for (std::size_t i = 0; i < slots.size();) {
