@@ -24,7 +24,7 @@ RUN apt-get update \
       libmosquitto1 libpng16-16 libprometheus-cpp-core1.0 \
       libprometheus-cpp-pull1.0 libprotobuf32 libpugixml1v5 libspdlog1.10 libssl3 libstdc++6 \
       libtbb12 libcairo2 libglib2.0-0 libpango-1.0-0 libpangocairo-1.0-0 fonts-dejavu-core \
-      libsqlite3-0 libpqxx-6.4 libpq5 \
+      libsqlite3-0 libpqxx-6.4 libpq5 zlib1g \
  && rm -rf /var/lib/apt/lists/*
 RUN useradd --system --uid 10001 --user-group --home-dir /var/lib/surfinspect --create-home \
       --shell /usr/sbin/nologin surfinspect
