@@ -92,7 +92,7 @@ MeshIndex::~MeshIndex() = default;
 const Eigen::Vector3d& MeshIndex::Pseudonormal(uint32_t triangle, ClosestFeature feature) const {
   const int k = FeatureIndex(feature);
   if (IsEdge(feature)) return edge_normal_[triangle_edges_[triangle][k]];
-  if (IsVertex(feature)) return vertex_normal_[weld_[ordered_.triangles[triangle][k]]];
+  if (IsVertex(feature)) return VertexNormal(weld_[ordered_.triangles[triangle][k]]);
   return face_normal_[triangle];
 }
 
@@ -237,8 +237,9 @@ std::size_t MeshIndex::memory_bytes() const {
          face_normal_.capacity() * sizeof(Eigen::Vector3d) + shape_.capacity() +
          triangle_edges_.capacity() * sizeof(triangle_edges_[0]) +
          edge_normal_.capacity() * sizeof(Eigen::Vector3d) + weld_.capacity() * sizeof(uint32_t) +
-         vertex_normal_.capacity() * sizeof(Eigen::Vector3d) + (bvh_ ? bvh_->memory_bytes() : 0) +
-         (certificates_ ? certificates_->memory_bytes() : 0);
+         (corner_start_.capacity() + corners_.capacity()) * sizeof(uint32_t) +
+         vertex_normal_.capacity() * (sizeof(Eigen::Vector3d) + 1) +
+         (bvh_ ? bvh_->memory_bytes() : 0) + (certificates_ ? certificates_->memory_bytes() : 0);
 }
 
 }  // namespace surfinspect

@@ -155,16 +155,23 @@ void MeshIndex::ApplyOrder(MeshOrder order) {
   std::vector<std::array<uint32_t, 3>> edges(triangle_edges_.size());
   for (std::size_t i = 0; i < edges.size(); ++i) edges[i] = triangle_edges_[mesh_triangle_[i]];
   triangle_edges_ = std::move(edges);
-  // A vertex's representative keeps its role under its new position.
-  std::vector<uint32_t> weld(weld_.size());
-  std::vector<Eigen::Vector3d> vertex_normal(vertex_normal_.size());
-  for (std::size_t v = 0; v < weld_.size(); ++v) {
+  // A vertex's representative keeps its role, and its corners, under its
+  // new position.
+  const std::size_t nv = weld_.size();
+  std::vector<uint32_t> weld(nv), corner_start(nv + 1, 0);
+  for (std::size_t v = 0; v < nv; ++v) {
     const uint32_t at = order.position_of_vertex[v];
     weld[at] = order.position_of_vertex[weld_[v]];
-    vertex_normal[at] = vertex_normal_[v];
+    corner_start[at + 1] = corner_start_[v + 1] - corner_start_[v];
   }
+  for (std::size_t v = 0; v < nv; ++v) corner_start[v + 1] += corner_start[v];
+  std::vector<uint32_t> corners(corners_.size());
+  for (std::size_t v = 0; v < nv; ++v)
+    std::copy(corners_.begin() + corner_start_[v], corners_.begin() + corner_start_[v + 1],
+              corners.begin() + corner_start[order.position_of_vertex[v]]);
   weld_ = std::move(weld);
-  vertex_normal_ = std::move(vertex_normal);
+  corner_start_ = std::move(corner_start);
+  corners_ = std::move(corners);
 }
 
 }  // namespace surfinspect

@@ -3,6 +3,7 @@
 // (Bærentzen & Aanæs 2005).
 #include <algorithm>
 #include <cmath>
+#include <thread>
 
 #include "core/distance/mesh_index.h"
 #include "core/types/first_equal_point.h"
@@ -85,19 +86,51 @@ void MeshIndex::ComputeFeatureNormals() {
     i = j;
   }
 
-  // Vertices: each incident face normal weighted by its angle at the vertex.
-  vertex_normal_.assign(verts.size(), Eigen::Vector3d::Zero());
-  for (std::size_t t = 0; t < tris.size(); ++t) {
-    if (face_normal_[t].isZero()) continue;
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector3d v = verts[tris[t][k]].cast<double>();
-      const Eigen::Vector3d u = verts[tris[t][(k + 1) % 3]].cast<double>();
-      const Eigen::Vector3d w = verts[tris[t][(k + 2) % 3]].cast<double>();
-      vertex_normal_[weld_[tris[t][k]]] += Angle(v, u, w) * face_normal_[t];
-    }
+  // Vertices: the corners of the triangles with a normal, by
+  // representative, in (t, k) order (a counting sort of the corners).
+  corner_start_.assign(verts.size() + 1, 0);
+  for (std::size_t t = 0; t < tris.size(); ++t)
+    if (!face_normal_[t].isZero())
+      for (int k = 0; k < 3; ++k) ++corner_start_[weld_[tris[t][k]] + 1];
+  for (std::size_t v = 0; v < verts.size(); ++v) corner_start_[v + 1] += corner_start_[v];
+  corners_.resize(corner_start_.back());
+  std::vector<uint32_t> fill(corner_start_.begin(), corner_start_.end() - 1);
+  for (std::size_t t = 0; t < tris.size(); ++t)
+    if (!face_normal_[t].isZero())
+      for (int k = 0; k < 3; ++k)
+        corners_[fill[weld_[tris[t][k]]]++] = static_cast<uint32_t>(t * 3 + k);
+  vertex_normal_.resize(verts.size());
+  vertex_normal_state_.reset(new std::atomic<uint8_t>[verts.size()]());
+}
+
+// Each incident face normal weighted by its angle at the vertex, summed in
+// the corners' (t, k) order. Made once, by the first thread to claim it;
+// another that asks meanwhile waits the sum's few hundred nanoseconds.
+const Eigen::Vector3d& MeshIndex::VertexNormal(uint32_t representative) const {
+  std::atomic<uint8_t>& state = vertex_normal_state_[representative];
+  uint8_t seen = state.load(std::memory_order_acquire);
+  if (seen == 0 && state.compare_exchange_strong(seen, 1, std::memory_order_acquire)) {
+    vertex_normal_[representative] = SumVertexNormal(representative);
+    state.store(2, std::memory_order_release);
+    return vertex_normal_[representative];
   }
-  for (auto& n : vertex_normal_)
-    if (n.norm() > 0) n.normalize();
+  while (state.load(std::memory_order_acquire) != 2) std::this_thread::yield();
+  return vertex_normal_[representative];
+}
+
+Eigen::Vector3d MeshIndex::SumVertexNormal(uint32_t representative) const {
+  Eigen::Vector3d n = Eigen::Vector3d::Zero();
+  for (uint32_t j = corner_start_[representative]; j < corner_start_[representative + 1]; ++j) {
+    const uint32_t t = corners_[j] / 3;
+    const int k = static_cast<int>(corners_[j] % 3);
+    const Triangle& tri = mesh_.triangles[t];
+    const Eigen::Vector3d v = mesh_.vertices[tri[k]].cast<double>();
+    const Eigen::Vector3d u = mesh_.vertices[tri[(k + 1) % 3]].cast<double>();
+    const Eigen::Vector3d w = mesh_.vertices[tri[(k + 2) % 3]].cast<double>();
+    n += Angle(v, u, w) * face_normal_[position_of_triangle_[t]];
+  }
+  if (n.norm() > 0) n.normalize();
+  return n;
 }
 
 MeshTopology MeshIndex::Topology() const {

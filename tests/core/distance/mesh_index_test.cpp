@@ -385,6 +385,41 @@ TEST(MeshIndex, SignIsRightAtSharpSheetMetalFolds) {
   EXPECT_GT(checked, 8000);
 }
 
+TEST(MeshIndex, VertexPseudonormalsMadeOnFirstUseAgreeAcrossThreads) {
+  // Points beyond the corners of a crumpled ball (its saddle vertices need
+  // the angle weights), each asked many times in a shuffled order, so that
+  // threads ask for the same vertex normals at once; a fresh index per run.
+  const TriangleMesh m = CrumpledBall(2);
+  std::vector<Eigen::Vector3f> pts;
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> out(0.01, 0.3);
+  for (int rep = 0; rep < 40; ++rep)
+    for (const Eigen::Vector3f& v : m.vertices) pts.push_back(v * static_cast<float>(1 + out(rng)));
+  std::shuffle(pts.begin(), pts.end(), rng);
+  const PointCloud cloud = PointCloud::Unorganized(std::move(pts));
+  std::vector<double> want;
+  for (const Eigen::Vector3f& p : cloud.points) {
+    const ClosestPoint r = BuildOrDie(m)->Closest(p.cast<double>());
+    want.push_back(r.signed_distance_mm);
+    if (want.size() == 200) break;  // a fresh index per point: the serial oracle
+  }
+  int at_vertex = 0;
+  for (int threads : {1, 2, 8}) {
+    auto index = BuildOrDie(m);
+    ASSERT_TRUE(index);
+    BatchQuerySettings s;
+    s.threads = threads;
+    auto got = QueryClosest(*index, cloud, Eigen::Isometry3d::Identity(), s);
+    ASSERT_TRUE(got.ok());
+    for (std::size_t i = 0; i < want.size(); ++i) EXPECT_EQ((*got)[i].signed_distance_mm, want[i]);
+    for (const ClosestPoint& r : *got) {
+      at_vertex += IsVertex(r.feature);
+      EXPECT_GT(r.signed_distance_mm, 0) << "outside the ball";
+    }
+  }
+  EXPECT_GT(at_vertex, 1000);
+}
+
 TEST(MeshIndex, PyramidApexAndPitUseTheVertexPseudonormal) {
   for (double k : {0.3, 1.0, 4.0}) {
     for (double s : {-1.0, 1.0}) {  // apex (s = -1) and pit (s = +1)
