@@ -126,12 +126,12 @@ void AppendPlyRows(const PointCloud& points, const ErrorMapResult& result, std::
   }
 }
 
-// Each piece of the colour scale blends two colours, each channel
-// rounded(x + (y - x) w) with halves away from zero; the constant ones
-// (beyond the scale) blend a colour with itself, at weight 0. DeviationColor below picks the piece
-// and the weight by index: on measured deviations the sign and the band go either way at random,
-// and branches on them are mispredicted.
-// The blend's terms per channel, as doubles: x and y - x (exact: small integers).
+// Each piece of the colour scale blends two colours, each channel rounded
+// from x + (y - x) w, halves away from zero; the constant pieces (beyond the
+// scale) blend a colour with itself at weight 0. DeviationColor picks the
+// piece and the weight by index: on measured deviations the sign and the
+// band go either way at random, and branches on them are mispredicted. A
+// piece holds x and y - x per channel as doubles (exact: small integers).
 struct Piece {
   double from[3], step[3];
   constexpr Piece(Rgb a, Rgb b)
