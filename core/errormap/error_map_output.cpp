@@ -12,6 +12,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/io/atomic_file.h"
+#include "core/types/default_init_vector.h"
 #include "core/types/round_half_away.h"
 
 namespace surfinspect {
@@ -106,24 +107,27 @@ nlohmann::json Stats(const ComponentStats& c) {
 }
 
 // The binary rows (x y z, deviation twice, rgb) of the valid points in
-// [from, to).
-void AppendPlyRows(const PointCloud& points, const ErrorMapResult& result, std::size_t from,
-                   std::size_t to, std::string& out) {
-  out.reserve(out.size() + (to - from) * 23);
-  char record[23];
+// [from, to), in place of `out`'s contents (sized for every point first,
+// without zeroing, then cut to the rows written).
+void EncodePlyRows(const PointCloud& points, const ErrorMapResult& result, std::size_t from,
+                   std::size_t to, DefaultInitVector<char>& out) {
+  constexpr std::size_t kRow = 23;
+  out.resize((to - from) * kRow);
+  char* row = out.data();
   for (std::size_t i = from; i < to; ++i) {
     const Eigen::Vector3f& p = points.points[i];
     if (!PointCloud::IsValid(p)) continue;
     const float d = result.deviation_mm[i];
     const Rgb c = DeviationColor(d, result.tolerance_mm, result.color_range_mm);
-    std::memcpy(record, p.data(), 12);
-    std::memcpy(record + 12, &d, 4);
-    std::memcpy(record + 16, &d, 4);
-    record[20] = static_cast<char>(c.r);
-    record[21] = static_cast<char>(c.g);
-    record[22] = static_cast<char>(c.b);
-    out.append(record, sizeof(record));
+    std::memcpy(row, p.data(), 12);
+    std::memcpy(row + 12, &d, 4);
+    std::memcpy(row + 16, &d, 4);
+    row[20] = static_cast<char>(c.r);
+    row[21] = static_cast<char>(c.g);
+    row[22] = static_cast<char>(c.b);
+    row += kRow;
   }
+  out.resize(static_cast<std::size_t>(row - out.data()));
 }
 
 // Each piece of the colour scale blends two colours, each channel rounded
@@ -189,16 +193,15 @@ absl::Status WriteErrorMapPly(const std::string& path, const PointCloud& points,
     // point order (the colour is most of a row's cost); each group is
     // written while the next one is encoded.
     constexpr std::size_t kBlock = std::size_t{1} << 15, kGroup = 8;
-    std::vector<std::string> encoded(kGroup), writing(kGroup);
+    std::vector<DefaultInitVector<char>> encoded(kGroup), writing(kGroup);
     auto encode = [&](std::size_t first) {
       tbb::parallel_for(std::size_t{0}, kGroup, [&](std::size_t b) {
-        encoded[b].clear();
         const std::size_t from = std::min(points.size(), first + b * kBlock);
-        AppendPlyRows(points, result, from, std::min(points.size(), from + kBlock), encoded[b]);
+        EncodePlyRows(points, result, from, std::min(points.size(), from + kBlock), encoded[b]);
       });
     };
     auto write = [&] {
-      for (const std::string& r : writing) out.Append(r);
+      for (const DefaultInitVector<char>& r : writing) out.Append(r.data(), r.size());
     };
     encode(0);
     for (std::size_t next = kBlock * kGroup;; next += kBlock * kGroup) {
