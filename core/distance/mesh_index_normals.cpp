@@ -11,29 +11,42 @@
 namespace surfinspect {
 namespace {
 
+constexpr uint32_t kNoBucket = UINT32_MAX;
+
+// The indices i of `bucket` (each < n, or kNoBucket to leave i out) grouped
+// by bucket, in increasing i within each: a stable counting sort. Bucket v
+// holds items[start[v], start[v + 1]).
+void GroupByBucket(const std::vector<uint32_t>& bucket, std::size_t n, std::vector<uint32_t>& start,
+                   std::vector<uint32_t>& items) {
+  start.assign(n + 1, 0);
+  for (uint32_t b : bucket)
+    if (b != kNoBucket) ++start[b + 1];
+  for (std::size_t v = 0; v < n; ++v) start[v + 1] += start[v];
+  std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+  items.resize(start.back());
+  for (std::size_t i = 0; i < bucket.size(); ++i)
+    if (bucket[i] != kNoBucket) items[fill[bucket[i]]++] = static_cast<uint32_t>(i);
+}
+
 // The corner slots t * 3 + k of `tris`, each naming the edge from its corner
 // to the next, sorted by the edge's welded vertex pair (u, w), u < w, with
-// equal pairs in slot order (a stable sort by u * n + w). Counted into one
-// bucket per u, slot by slot, then each bucket (a vertex's few edges) put
-// in w order by insertion, which keeps equal pairs in slot order: about a
-// quarter of a radix sort's time on the 64-bit keys. `keys` gets u * n + w.
+// equal pairs in slot order (a stable sort by u * n + w). Grouped by u, then
+// each group (a vertex's few edges) put in w order by insertion, which keeps
+// equal pairs in slot order: about a quarter of a radix sort's time on the
+// 64-bit keys. `keys` gets u * n + w.
 void SortEdgeSlots(const std::vector<Triangle>& tris, const std::vector<uint32_t>& weld,
                    std::vector<uint64_t>& keys, std::vector<uint32_t>& slots) {
   const std::size_t n = weld.size(), m = tris.size() * 3;
-  std::vector<uint32_t> low(m), high(m), start(n + 1, 0);
+  std::vector<uint32_t> low(m), high(m), start;
   for (std::size_t t = 0; t < tris.size(); ++t)
     for (int k = 0; k < 3; ++k) {
       uint32_t u = weld[tris[t][k]], w = weld[tris[t][(k + 1) % 3]];
       if (u > w) std::swap(u, w);
       low[t * 3 + k] = u;
       high[t * 3 + k] = w;
-      ++start[u + 1];
     }
-  for (std::size_t v = 0; v < n; ++v) start[v + 1] += start[v];
-  std::vector<uint32_t> fill(start.begin(), start.end() - 1);
-  slots.resize(m);
+  GroupByBucket(low, n, start, slots);
   keys.resize(m);
-  for (std::size_t i = 0; i < m; ++i) slots[fill[low[i]]++] = static_cast<uint32_t>(i);
   for (std::size_t v = 0; v < n; ++v)
     for (uint32_t j = start[v] + 1; j < start[v + 1]; ++j) {
       const uint32_t slot = slots[j];
@@ -87,18 +100,12 @@ void MeshIndex::ComputeFeatureNormals() {
   }
 
   // Vertices: the corners of the triangles with a normal, by
-  // representative, in (t, k) order (a counting sort of the corners).
-  corner_start_.assign(verts.size() + 1, 0);
+  // representative, in (t, k) order.
+  std::vector<uint32_t> corner_vertex(tris.size() * 3, kNoBucket);
   for (std::size_t t = 0; t < tris.size(); ++t)
     if (!face_normal_[t].isZero())
-      for (int k = 0; k < 3; ++k) ++corner_start_[weld_[tris[t][k]] + 1];
-  for (std::size_t v = 0; v < verts.size(); ++v) corner_start_[v + 1] += corner_start_[v];
-  corners_.resize(corner_start_.back());
-  std::vector<uint32_t> fill(corner_start_.begin(), corner_start_.end() - 1);
-  for (std::size_t t = 0; t < tris.size(); ++t)
-    if (!face_normal_[t].isZero())
-      for (int k = 0; k < 3; ++k)
-        corners_[fill[weld_[tris[t][k]]]++] = static_cast<uint32_t>(t * 3 + k);
+      for (int k = 0; k < 3; ++k) corner_vertex[t * 3 + k] = weld_[tris[t][k]];
+  GroupByBucket(corner_vertex, verts.size(), corner_start_, corners_);
   vertex_normal_.resize(verts.size());
   vertex_normal_state_.reset(new std::atomic<uint8_t>[verts.size()]());
 }
