@@ -23,13 +23,13 @@ struct Accumulator {
   double sum = 0, sum2 = 0, min = INFINITY, max = -INFINITY;
 
   void Add(float d, const ToleranceBand& band) {
+    // Counted without branches: most points of a failing part fall on
+    // either side of the band at random, which a branch mispredicts.
     ++count;
-    if (band.Contains(d))
-      ++within;
-    else if (d > static_cast<float>(band.upper_mm))
-      ++above;
-    else
-      ++below;
+    const bool in = band.Contains(d), high = d > static_cast<float>(band.upper_mm);
+    within += in;
+    above += !in & high;
+    below += !in & !high;
     const double v = d;
     sum += v;
     sum2 += v * v;
@@ -64,11 +64,18 @@ void AccumulateChunk(const ErrorMapResult& em, const ResolvedInspectionPlan& rp,
   const std::size_t region_base = 1, point_base = 1 + rp.plan.regions.size();
   std::vector<double> radius_sq;
   for (const ComparisonPoint& p : rp.plan.points) radius_sq.push_back(p.radius_mm * p.radius_mm);
+  // Without regions or points only the surface counts: no lookups by triangle.
+  const bool per_triangle = !rp.region_ids.empty() || !rp.point_ids.empty();
+  // The surface's sums in locals: through acc[0] every store to them could
+  // change bands[0] (both double), so each point would reload and store all.
+  Accumulator surface = acc[0];
+  const ToleranceBand surface_band = bands[0];
   for (std::size_t i = first; i < last; ++i) {
     const uint32_t t = em.triangle_id[i];
     if (t == UINT32_MAX) continue;
     const float d = em.deviation_mm[i];
-    acc[0].Add(d, bands[0]);
+    surface.Add(d, surface_band);
+    if (!per_triangle) continue;
     for (uint32_t k = rp.region_offsets[t]; k < rp.region_offsets[t + 1]; ++k) {
       const std::size_t c = region_base + rp.region_ids[k];
       acc[c].Add(d, bands[c]);
@@ -82,6 +89,7 @@ void AccumulateChunk(const ErrorMapResult& em, const ResolvedInspectionPlan& rp,
       }
     }
   }
+  acc[0] = surface;
 }
 
 void FillStats(const Accumulator& a, CharacteristicResult& c) {

@@ -164,9 +164,13 @@ absl::StatusOr<ResolvedInspectionPlan> ResolveInspectionPlan(const InspectionPla
       group_index[k] = static_cast<uint32_t>(
           std::find(groups.names.begin(), groups.names.end(), r.plan.regions[k].select.group) -
           groups.names.begin());
-  std::vector<Eigen::Vector3d> centroid(nt);
-  std::vector<std::array<Eigen::Vector3d, 3>> corners(nt);
-  for (std::size_t t = 0; t < nt; ++t) {
+  // Centroids and corners only when a region or a point asks: the default
+  // plan (the whole surface) needs neither, and for a large mesh they are
+  // most of this function's time.
+  const bool geometry = !r.plan.regions.empty() || !r.plan.points.empty();
+  std::vector<Eigen::Vector3d> centroid(geometry ? nt : 0);
+  std::vector<std::array<Eigen::Vector3d, 3>> corners(geometry ? nt : 0);
+  for (std::size_t t = 0; t < centroid.size(); ++t) {
     for (int c = 0; c < 3; ++c) corners[t][c] = part.vertices[part.triangles[t][c]].cast<double>();
     centroid[t] = (corners[t][0] + corners[t][1] + corners[t][2]) / 3.0;
   }
@@ -181,8 +185,8 @@ absl::StatusOr<ResolvedInspectionPlan> ResolveInspectionPlan(const InspectionPla
   for (uint32_t k : r.region_ids) ++r.region_triangle_count[k];
   // A triangle can reach a point when its closest point to the position is
   // within the radius; the bounding-sphere test first skips the far ones.
-  std::vector<double> bound(nt);
-  for (std::size_t t = 0; t < nt; ++t)
+  std::vector<double> bound(r.plan.points.empty() ? 0 : nt);
+  for (std::size_t t = 0; t < bound.size(); ++t)
     for (int c = 0; c < 3; ++c) bound[t] = std::max(bound[t], (corners[t][c] - centroid[t]).norm());
   BuildRows(
       nt, r.plan.points.size(),

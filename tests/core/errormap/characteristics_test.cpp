@@ -56,7 +56,7 @@ InspectionPlan RandomPlan(const TriangleMesh& m) {
 
 // Two-pass statistics in double over the selected matched deviations.
 struct Direct {
-  std::size_t n = 0, within = 0;
+  std::size_t n = 0, within = 0, above = 0, below = 0;
   double min = INFINITY, max = -INFINITY, mean = NAN, stddev = NAN, rms = NAN;
 };
 template <typename Select>
@@ -65,8 +65,14 @@ Direct DirectStats(const ErrorMapResult& em, const ToleranceBand& band, Select s
   std::vector<double> v;
   for (std::size_t i = 0; i < em.deviation_mm.size(); ++i)
     if (em.triangle_id[i] != UINT32_MAX && select(i)) {
-      v.push_back(em.deviation_mm[i]);
-      d.within += band.Contains(em.deviation_mm[i]);
+      const float x = em.deviation_mm[i];
+      v.push_back(x);
+      if (band.Contains(x))
+        ++d.within;
+      else if (x > static_cast<float>(band.upper_mm))
+        ++d.above;
+      else
+        ++d.below;
     }
   d.n = v.size();
   if (v.empty()) return d;
@@ -84,6 +90,8 @@ Direct DirectStats(const ErrorMapResult& em, const ToleranceBand& band, Select s
 void ExpectMatches(const CharacteristicResult& c, const Direct& d) {
   EXPECT_EQ(c.points, d.n) << c.name;
   EXPECT_EQ(c.within, d.within) << c.name;
+  EXPECT_EQ(c.above, d.above) << c.name;
+  EXPECT_EQ(c.below, d.below) << c.name;
   if (d.n == 0) return;
   EXPECT_EQ(c.min_mm, d.min) << c.name;
   EXPECT_EQ(c.max_mm, d.max) << c.name;
@@ -111,6 +119,19 @@ TEST(Characteristics, RegionsAndPointsEqualBruteForce) {
   ExpectMatches(surface, DirectStats(em, plan.tolerance, [](std::size_t) { return true; }));
   EXPECT_EQ(surface.mean_mm, em.stats.mean_mm) << "the error map's own statistics";
   EXPECT_EQ(surface.points, em.stats.matched);
+  // A plan with neither regions nor points (the default) skips the lookups
+  // by triangle: the same surface.
+  InspectionPlan bare;
+  bare.tolerance = plan.tolerance;
+  auto rb = ResolveInspectionPlan(bare, m);
+  ASSERT_TRUE(rb.ok()) << rb.status();
+  EXPECT_TRUE(rb->region_ids.empty() && rb->point_ids.empty());
+  EXPECT_EQ(rb->region_offsets.size(), m.num_triangles() + 1);
+  auto only_surface = ComputeCharacteristics(em, *rb);
+  ASSERT_TRUE(only_surface.ok()) << only_surface.status();
+  ASSERT_EQ(only_surface->characteristics.size(), 1u);
+  ExpectMatches(only_surface->characteristics[0],
+                DirectStats(em, plan.tolerance, [](std::size_t) { return true; }));
 
   // Region membership by brute force: the closest triangle's centroid in the
   // box, or its id in the list.
