@@ -282,29 +282,55 @@ double ErrorMapAndPly(const ErrorMapArgs& a, const PointCloud& cloud_in_world,
   return ply_seconds;
 }
 
+// The command's inputs, read and checked before anything is measured.
+struct ErrorMapInputs {
+  PointCloud cloud_in_world;
+  Eigen::Isometry3d world_from_part;
+  nlohmann::json plan_json;  // null without --plan
+  TriangleMesh mesh;
+  InspectionPlan plan;
+  bool keeps_cloud = false;  // the part frame's cloud would be a bit-identical copy
+  double read_seconds = 0;
+};
+
+ErrorMapInputs ReadInputs(const ErrorMapArgs& a) {
+  const auto t0 = std::chrono::steady_clock::now();
+  // Each reader is serial, so the two files are read at once; their errors
+  // are still reported in the order below. The cloud's task also reads the
+  // pose and decides whether the part frame needs a copy of the cloud (a
+  // pass over every coordinate), while the mesh is still being read.
+  absl::StatusOr<PointCloud> cloud_read;
+  absl::StatusOr<Eigen::Isometry3d> pose_read = Eigen::Isometry3d::Identity();
+  absl::StatusOr<TriangleMesh> mesh_read;
+  ErrorMapInputs in;
+  tbb::parallel_invoke(
+      [&] {
+        cloud_read = ReadPointCloud(a.cloud);
+        if (!a.world_from_part.empty()) pose_read = ReadTransformJson(a.world_from_part);
+        in.keeps_cloud = cloud_read.ok() && pose_read.ok() &&
+                         TransformKeepsCloud(*cloud_read, pose_read->inverse());
+      },
+      [&] { mesh_read = ReadMesh(a.mesh); });
+  in.cloud_in_world = Take(std::move(cloud_read));
+  in.world_from_part = Take(std::move(pose_read));
+  if (!a.plan.empty()) in.plan_json = Take(client::ReadPlanJson(a.plan));
+  in.mesh = Take(std::move(mesh_read));
+  // A bad plan is refused before anything is measured.
+  in.plan = a.plan.empty() ? PlanFromSettings(a.settings)
+                           : Take(ParsePlanForMeshFile(in.plan_json, in.mesh, a.mesh, a.settings));
+  in.read_seconds = Seconds(t0);
+  spdlog::info("read {} points and {} triangles in {:.3f} s", in.cloud_in_world.size(),
+               in.mesh.num_triangles(), in.read_seconds);
+  return in;
+}
+
 void RunErrorMap(const ErrorMapArgs& a) {
   const std::unique_ptr<ResultsStore> store = a.db.empty() ? nullptr : OpenStore(a.db, false);
-  auto t0 = std::chrono::steady_clock::now();
-  // Each reader is serial, so the two files are read at once; their errors
-  // are still reported in the order below.
-  absl::StatusOr<PointCloud> cloud_read;
-  absl::StatusOr<TriangleMesh> mesh_read;
-  tbb::parallel_invoke([&] { cloud_read = ReadPointCloud(a.cloud); },
-                       [&] { mesh_read = ReadMesh(a.mesh); });
-  const PointCloud cloud_in_world = Take(std::move(cloud_read));
-  const Eigen::Isometry3d world_from_part = a.world_from_part.empty()
-                                                ? Eigen::Isometry3d::Identity()
-                                                : Take(ReadTransformJson(a.world_from_part));
-  const nlohmann::json plan_json =
-      a.plan.empty() ? nlohmann::json() : Take(client::ReadPlanJson(a.plan));
-  const TriangleMesh mesh = Take(std::move(mesh_read));
-  // A bad plan is refused before anything is measured.
-  const InspectionPlan plan = a.plan.empty()
-                                  ? PlanFromSettings(a.settings)
-                                  : Take(ParsePlanForMeshFile(plan_json, mesh, a.mesh, a.settings));
-  const double read_seconds = Seconds(t0);
-  spdlog::info("read {} points and {} triangles in {:.3f} s", cloud_in_world.size(),
-               mesh.num_triangles(), read_seconds);
+  const auto t0 = std::chrono::steady_clock::now();
+  const ErrorMapInputs in = ReadInputs(a);
+  const PointCloud& cloud_in_world = in.cloud_in_world;
+  const Eigen::Isometry3d& world_from_part = in.world_from_part;
+  const TriangleMesh& mesh = in.mesh;
   // Reported only. In-process, the index build counts them; for the
   // server, they are counted here meanwhile.
   nlohmann::json mesh_json;
@@ -315,14 +341,12 @@ void RunErrorMap(const ErrorMapArgs& a) {
     });
   // Without --world-from-part the two frames are one: the same points,
   // without a copy of the cloud, when the copy would be bit-identical.
-  const Eigen::Isometry3d part_from_world = world_from_part.inverse();
   std::optional<PointCloud> moved;
-  if (!TransformKeepsCloud(cloud_in_world, part_from_world))
-    moved = TransformCloud(cloud_in_world, part_from_world);
+  if (!in.keeps_cloud) moved = TransformCloud(cloud_in_world, world_from_part.inverse());
   const PointCloud& cloud_in_part = moved ? *moved : cloud_in_world;
   ErrorMapRun run;
   const double ply_seconds =
-      ErrorMapAndPly(a, cloud_in_world, cloud_in_part, world_from_part, mesh, plan, run);
+      ErrorMapAndPly(a, cloud_in_world, cloud_in_part, world_from_part, mesh, in.plan, run);
   counting.wait();
   if (!a.remote.remote()) mesh_json = std::move(run.mesh);
   // Files carry part-frame coordinates by default, so they overlay the CAD.
@@ -343,7 +367,7 @@ void RunErrorMap(const ErrorMapArgs& a) {
   if (!a.report.empty()) {
     // The remote report's timing is the server's; the local one is all ours.
     nlohmann::json& timing = run.report["timing"];
-    timing["read_seconds"] = read_seconds;
+    timing["read_seconds"] = in.read_seconds;
     if (!a.remote.remote()) {
       timing["build_seconds"] = run.build_seconds;
       timing["plan_seconds"] = run.plan_seconds;
@@ -358,7 +382,7 @@ void RunErrorMap(const ErrorMapArgs& a) {
     Check(WriteStringAtomically(a.report, run.report.dump(2) + "\n"));
   }
   PrintSummary(a, run);
-  if (store) RecordErrorMap(*store, a, cloud_in_world, world_from_part, mesh, plan_json, run);
+  if (store) RecordErrorMap(*store, a, cloud_in_world, world_from_part, mesh, in.plan_json, run);
 }
 
 }  // namespace

@@ -95,10 +95,12 @@ class WideBvhBuilder {
   void FillBlocks() {
     const std::size_t blocks = (slots_ + wide::kLeafWidth - 1) / wide::kLeafWidth;
     lane_triangle_.resize(blocks * wide::kLeafWidth, UINT32_MAX);
-    out_.blocks_.assign(blocks, EmptyLeafBlock());
+    out_.blocks_.resize(blocks);
+    const wide::LeafBlock empty = EmptyLeafBlock();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, 256),
                       [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t b = r.begin(); b != r.end(); ++b)
+                        for (std::size_t b = r.begin(); b != r.end(); ++b) {
+                          out_.blocks_[b] = empty;
                           for (int lane = 0; lane < wide::kLeafWidth; ++lane) {
                             const uint32_t t = lane_triangle_[b * wide::kLeafWidth + lane];
                             if (t == UINT32_MAX) continue;
@@ -107,6 +109,7 @@ class WideBvhBuilder {
                             FillLeafLane(out_.blocks_[b], lane, t, v[tri[0]], v[tri[1]], v[tri[2]],
                                          normals_[t], shapes_[t]);
                           }
+                        }
                       });
   }
 

@@ -24,6 +24,7 @@
 #include "absl/status/statusor.h"
 #include "core/distance/point_triangle.h"
 #include "core/distance/wide_bvh_layout.h"
+#include "core/types/default_init_vector.h"
 #include "core/types/triangle_mesh.h"
 
 namespace surfinspect {
@@ -59,7 +60,7 @@ class WideBvh {
   void VisitLanes(uint32_t block, uint32_t lanes, wide::Query& query) const {
     visit_(view(), block, lanes, query);
   }
-  const std::vector<wide::LeafBlock>& blocks() const { return blocks_; }
+  const DefaultInitVector<wide::LeafBlock>& blocks() const { return blocks_; }
   wide::View view() const { return {nodes_.data(), blocks_.data()}; }
   SearchIsa isa() const { return isa_; }
   const WideBvhStats& stats() const { return stats_; }
@@ -67,7 +68,9 @@ class WideBvh {
 
  private:
   std::vector<wide::Node> nodes_;
-  std::vector<wide::LeafBlock> blocks_;
+  // Left unwritten by resize: the parallel fill writes every block, so its
+  // pages are first touched on all cores, not in one serial pass.
+  DefaultInitVector<wide::LeafBlock> blocks_;
   SearchIsa isa_ = SearchIsa::kSse2;
   void (*search_)(const wide::View&, wide::Query&) = &wide::sse2::Search;
   void (*visit_)(const wide::View&, uint32_t, uint32_t, wide::Query&) = &wide::sse2::VisitLanes;
