@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -67,17 +68,32 @@ TEST(PointCloud, CountValidAndForEachValidVisitTheValidPixelsInStorageOrder) {
 }
 
 TEST(PointCloud, CountValidMatchesABruteCountOnRandomHoles) {
+  // Any coordinate, or several, NaN (of either sign), +-inf, or a finite
+  // extreme (the largest float, the smallest subnormal, -0): counted as
+  // IsValid counts them.
   std::mt19937 rng(5);
-  std::uniform_int_distribution<int> kind(0, 4);
-  std::vector<Vector3f> pts(1000);
+  const float values[] = {1.5f,
+                          NAN,
+                          -NAN,
+                          INFINITY,
+                          -INFINITY,
+                          std::numeric_limits<float>::max(),
+                          -std::numeric_limits<float>::max(),
+                          std::numeric_limits<float>::denorm_min(),
+                          -0.0f};
+  std::uniform_int_distribution<int> pick(0, std::size(values) - 1);
+  std::bernoulli_distribution odd(0.3);
+  std::vector<Vector3f> pts(5000);
   std::size_t valid = 0;
   for (auto& p : pts) {
-    const int k = kind(rng);
     p = Vector3f(1, 2, 3);
-    if (k == 1) p.y() = NAN;
-    if (k == 2) p.z() = INFINITY;
-    if (k != 1 && k != 2) ++valid;
+    for (int k = 0; k < 3; ++k)
+      if (odd(rng)) p[k] = values[pick(rng)];
+    const bool finite = std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z());
+    valid += finite ? 1 : 0;
   }
+  EXPECT_GT(valid, 1000u);
+  EXPECT_LT(valid, 4000u);
   EXPECT_EQ(PointCloud::Unorganized(pts).CountValid(), valid);
 }
 
