@@ -1,6 +1,8 @@
 #include "core/distance/mesh_index.h"
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 #include "core/distance/hint_certificate.h"
 #include "core/distance/wide_bvh.h"
@@ -146,7 +148,12 @@ ClosestPoint MeshIndex::Closest(const Eigen::Vector3d& p_in_mesh, double max_dis
   const Eigen::Vector3d diff = p_in_mesh - out.point;
   double side = diff.dot(Pseudonormal(t, out.feature));
   if (side == 0) side = diff.dot(face_normal_[t]);
-  out.signed_distance_mm = side < 0 ? -out.distance_mm : out.distance_mm;
+  // The negation as a flip of the sign bit, with no branch: points fall on
+  // either side at random (a mispredicted branch per query on the bench).
+  uint64_t bits;
+  std::memcpy(&bits, &out.distance_mm, sizeof bits);
+  bits ^= static_cast<uint64_t>(side < 0) << 63;
+  std::memcpy(&out.signed_distance_mm, &bits, sizeof bits);
   return out;
 }
 

@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "absl/strings/str_cat.h"
+#include "core/types/float_scan.h"
 
 namespace surfinspect {
 
@@ -52,16 +53,9 @@ absl::Status PointCloud::Validate() const {
 namespace {
 
 // Whether any of the n floats is infinite: its bits with the sign cleared
-// are exactly the exponent's. One pass the compiler vectorizes, so a cloud
-// without infinities (every cloud that passes) is checked at memory speed.
+// are exactly the exponent's.
 bool AnyInfinite(const float* f, std::size_t n) {
-  uint32_t hit = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    uint32_t bits;
-    std::memcpy(&bits, f + i, sizeof bits);
-    hit |= static_cast<uint32_t>((bits & 0x7fffffffu) == 0x7f800000u);
-  }
-  return hit != 0;
+  return AnyFloatWithBits(f, n, 0x7fffffffu, 0x7f800000u);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "absl/strings/str_cat.h"
+#include "core/types/float_scan.h"
 
 namespace surfinspect {
 
@@ -54,19 +55,11 @@ PointCloud TransformCloud(const PointCloud& cloud, const Eigen::Isometry3d& to_f
 
 bool TransformKeepsCloud(const PointCloud& cloud, const Eigen::Isometry3d& to_from) {
   if (to_from.matrix() != Eigen::Matrix4d::Identity()) return false;
-  // -0 is the one float whose bits are 0x80000000 (a NaN pixel never is):
-  // an integer test over every coordinate, with no branch, vectorizes
-  // (10^6 points, warm: 0.9 ms against 1.9 ms for a test and a branch each).
+  // -0 is the one float whose bits are 0x80000000 (a NaN pixel never is).
   static_assert(sizeof(Eigen::Vector3f) == 12, "points are three packed floats");
-  const auto* bytes = reinterpret_cast<const unsigned char*>(cloud.points.data());
-  const std::size_t n = 3 * cloud.points.size();
-  bool negative_zero = false;
-  for (std::size_t i = 0; i < n; ++i) {
-    uint32_t w;
-    std::memcpy(&w, bytes + 4 * i, 4);
-    negative_zero |= w == 0x80000000u;
-  }
-  return !negative_zero;
+  if (cloud.points.empty()) return true;
+  return !AnyFloatWithBits(cloud.points[0].data(), 3 * cloud.points.size(), 0xffffffffu,
+                           0x80000000u);
 }
 
 PoseDifference ComparePoses(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
