@@ -28,6 +28,8 @@ absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path, const CloudRe
   const std::string ext = Extension(path);
   if (ext != "pcd" && ext != "ply")
     return Bad(path, "unknown cloud format (expected .pcd or .ply)");
+  if (ext == "ply")
+    if (auto direct = ReadPackedXyzPly(path, limits)) return *std::move(direct);
   auto bytes = ReadWholeFile(path, std::numeric_limits<uint64_t>::max());
   if (!bytes.ok()) return bytes.status();
   return ext == "pcd" ? ParsePcd(*bytes, limits, path) : ParsePlyCloud(*bytes, limits, path);

@@ -1,6 +1,11 @@
 #include "core/io/ply_cloud.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <limits>
 
 #include "absl/strings/str_cat.h"
@@ -169,6 +174,76 @@ absl::StatusOr<PointCloud> ParsePlyCloud(std::string_view bytes, const CloudRead
   PointCloud cloud = PointCloud::Unorganized(std::move(pts));
   if (auto st = cloud.Validate(); !st.ok()) return BadFile(name, st.message());
   return cloud;
+}
+
+namespace {
+
+// A header longer than this is read the general way.
+constexpr std::size_t kHeadBytes = 64 * 1024;
+
+struct Fd {
+  int fd;
+  ~Fd() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
+// Exactly n bytes at `offset`, or false.
+bool ReadAt(int fd, void* out, uint64_t n, uint64_t offset) {
+  auto* p = static_cast<char*>(out);
+  while (n > 0) {
+    const ssize_t got = ::pread(fd, p, n, static_cast<off_t>(offset));
+    if (got < 0 && errno == EINTR) continue;
+    if (got <= 0) return false;
+    p += got, n -= static_cast<uint64_t>(got), offset += static_cast<uint64_t>(got);
+  }
+  return true;
+}
+
+// Binary little-endian rows of float32 x, y, z alone, in the first element,
+// `vertex`; any other element empty (our writer's and PCL's `face 0`); and
+// an obj_info grid, if any, of as many cells as vertices (CheckGrid).
+bool PackedXyz(const PlyHeader& h) {
+  if (h.format != PlyFormat::kBinaryLittleEndian || h.elements.empty()) return false;
+  const PlyElement& v = h.elements[0];
+  if (v.name != "vertex" || v.count == 0 || v.properties.size() != 3) return false;
+  const char* axis[] = {"x", "y", "z"};
+  for (int a = 0; a < 3; ++a) {
+    const PlyProperty& p = v.properties[a];
+    if (p.name != axis[a] || p.is_list || p.type != PlyType::kFloat32) return false;
+  }
+  for (std::size_t e = 1; e < h.elements.size(); ++e)
+    if (h.elements[e].count != 0) return false;
+  uint64_t cells = 0;
+  return !h.num_cols || !h.num_rows ||
+         (CheckedMul(*h.num_cols, *h.num_rows, &cells) && cells == v.count);
+}
+
+}  // namespace
+
+std::optional<absl::StatusOr<PointCloud>> ReadPackedXyzPly(const std::string& path,
+                                                           const CloudReadLimits& limits) {
+  static_assert(sizeof(Eigen::Vector3f) == 12, "points are three packed floats");
+  static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__);
+  const Fd file{::open(path.c_str(), O_RDONLY | O_CLOEXEC)};
+  struct stat st;
+  if (file.fd < 0 || ::fstat(file.fd, &st) != 0 || !S_ISREG(st.st_mode) || st.st_size <= 0)
+    return std::nullopt;
+  const auto size = static_cast<uint64_t>(st.st_size);
+  std::string head(std::min<uint64_t>(size, kHeadBytes), '\0');
+  if (!ReadAt(file.fd, head.data(), head.size(), 0)) return std::nullopt;
+  const absl::StatusOr<PlyHeader> h = ParsePlyHeader(head, limits.max_points, path);
+  if (!h.ok() || !PackedXyz(*h)) return std::nullopt;
+  // The rows must all be there, as CheckBinarySize requires; bytes after
+  // them are allowed, as there.
+  const uint64_t count = h->elements[0].count;
+  if (h->data_offset > size || (size - h->data_offset) / 12 < count) return std::nullopt;
+  std::vector<Eigen::Vector3f> pts(count);  // Eigen's points: allocated, not zeroed
+  if (!ReadAt(file.fd, pts.data(), 12 * count, h->data_offset)) return std::nullopt;
+  PointCloud cloud = PointCloud::Unorganized(std::move(pts));
+  if (auto st = cloud.Validate(); !st.ok())
+    return absl::StatusOr<PointCloud>(BadFile(path, st.message()));
+  return absl::StatusOr<PointCloud>(std::move(cloud));
 }
 
 }  // namespace surfinspect
