@@ -4,9 +4,9 @@
 //  - Open3D: a python3 script that reads both files, builds its
 //    RaycastingScene and calls compute_distance;
 //  - CloudCompare: `CloudCompare -SILENT -C2M_DIST` on both files.
-// Each is a child process timed by wall clock, medians after one warm-up
-// run (the files in page cache for all). Agreement: our |deviation| from a
-// separate, untimed run with --csv against Open3D's unsigned distances.
+// Each is a child process timed by wall clock, medians of five runs after
+// one warm-up run (the files in page cache for all; CloudCompare once). Agreement: our |deviation|
+// from a separate, untimed run with --csv against Open3D's unsigned distances.
 #pragma once
 
 #include <unistd.h>
@@ -50,6 +50,15 @@ inline std::string BinDir() {
   std::string path(buf, static_cast<std::size_t>(n));
   return path.substr(0, path.rfind('/'));
 }
+
+// Timed runs of each command, after its warm-up run. Each command's runs
+// follow each other, as a cell runs one tool again and again: on this VM a
+// process that faults in fresh memory right after another has freed a lot
+// (the Open3D script frees several hundred MB) spends up to 0.2 s more in
+// the kernel, as the freed pages went back to the host (measured with
+// /usr/bin/time: ours 0.03-0.05 s of system time in a row, 0.07-0.22 s
+// after each Open3D run).
+constexpr int kCommandReps = 5;
 
 // Median wall seconds of `command` (a shell line), NaN if it ever fails.
 inline double CommandSeconds(const std::string& command, int reps) {
@@ -119,12 +128,12 @@ inline void AddCommandRows(std::vector<Row>& rows) {
   const std::string ours_run = BinDir() + "/surfinspect errormap --cloud " + cloud + " --mesh " +
                                mesh + " --out " + dir.File("out.ply") + " --report " +
                                dir.File("report.json");
-  const double ours = CommandSeconds(ours_run + kQuiet, 3);
+  const double ours = CommandSeconds(ours_run + kQuiet, kCommandReps);
   const std::string script = dir.File("o3d.py");
   std::ofstream(script) << kOpen3dScript;
   const bool have_o3d = std::system("/usr/bin/python3 -c 'import open3d' >/dev/null 2>&1") == 0;
   const std::string o3d_run = "/usr/bin/python3 " + script + " " + cloud + " " + mesh;
-  const double o3d = have_o3d ? CommandSeconds(o3d_run + kQuiet, 3) : NAN;
+  const double o3d = have_o3d ? CommandSeconds(o3d_run + kQuiet, kCommandReps) : NAN;
   std::string agreement = "—";
   if (have_o3d) {  // untimed runs: our CSV and Open3D's raw distances
     const bool ran =

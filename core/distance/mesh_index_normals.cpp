@@ -84,7 +84,12 @@ void MeshIndex::ComputeFeatureNormals() {
   std::vector<uint32_t> slots;
   SortEdgeSlots(tris, weld_, keys, slots);
   triangle_edges_.resize(tris.size());
+  // One normal per distinct key, reserved at its count: grown by doubling,
+  // the 180k-triangle bench mesh's 6.5 MB would fault in 17 MB more.
+  std::size_t edges = keys.empty() ? 0 : 1;
+  for (std::size_t i = 1; i < keys.size(); ++i) edges += keys[i] != keys[i - 1];
   edge_normal_.clear();
+  edge_normal_.reserve(edges);
   for (std::size_t i = 0; i < slots.size();) {
     std::size_t j = i;
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
