@@ -23,10 +23,10 @@ struct Accumulator {
   double sum = 0, sum2 = 0, min = INFINITY, max = -INFINITY;
 
   void Add(float d, const ToleranceBand& band) {
-    // Counted without branches: most points of a failing part fall on
-    // either side of the band at random, which a branch mispredicts.
+    // Counted without branches (Contains() without its short circuit, too):
+    // most points of a failing part fall on either side of the band at
+    // random, which a branch mispredicts.
     ++count;
-    // Contains() without its short circuit, which would branch on the lower edge.
     const float lower = static_cast<float>(band.lower_mm),
                 upper = static_cast<float>(band.upper_mm);
     const bool high = d > upper, in = (d >= lower) & (d <= upper);
