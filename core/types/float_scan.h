@@ -1,8 +1,7 @@
 // Whether any float of an array has given bits: one pass on the bits, with
 // no branch per float, which the compiler vectorizes, so a cloud is checked
-// at memory speed; a large array is split over the calling arena's threads
-// (a 10^6-point cloud alone on one core of this project's VMs: about
-// 2.5 ms, bound by the memory bandwidth one core gets).
+// at memory speed (10^6 points, warm: 0.42 ms). The infinity check of
+// PointCloud::Validate and the -0 test of TransformKeepsCloud.
 #pragma once
 
 #include <cstddef>

@@ -25,21 +25,8 @@ PointCloud PointCloud::Organized(uint32_t width, uint32_t height) {
 }
 
 std::size_t PointCloud::CountValid() const {
-  // IsValid on the bits, without its short circuit: a float is finite
-  // exactly when its exponent is not all ones. A scan whose holes come and
-  // go row by row mispredicts a branch per point (10^6 points: 2.5-3 ms
-  // with IsValid, measured in the error map's statistics).
-  static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float), "points are packed floats");
-  constexpr uint32_t kExponent = 0x7f800000u;
-  const float* f = points.empty() ? nullptr : points[0].data();
   std::size_t n = 0;
-  for (std::size_t i = 0; i < points.size(); ++i, f += 3) {
-    uint32_t bits[3];
-    std::memcpy(bits, f, sizeof bits);
-    n += static_cast<std::size_t>(((bits[0] & kExponent) != kExponent) &
-                                  ((bits[1] & kExponent) != kExponent) &
-                                  ((bits[2] & kExponent) != kExponent));
-  }
+  for (const auto& p : points) n += IsValid(p) ? 1 : 0;
   return n;
 }
 
