@@ -233,7 +233,10 @@ std::optional<absl::StatusOr<PointCloud>> ReadPackedXyzPly(const std::string& pa
   std::string head(std::min<uint64_t>(size, kHeadBytes), '\0');
   if (!ReadAt(file.fd, head.data(), head.size(), 0)) return std::nullopt;
   const absl::StatusOr<PlyHeader> h = ParsePlyHeader(head, limits.max_points, path);
-  if (!h.ok() || !PackedXyz(*h)) return std::nullopt;
+  // A header must end inside what was read, with its newline: a last line
+  // cut at the end of `head` reads as "end_header" there and not in the file.
+  if (!h.ok() || !PackedXyz(*h) || (head.size() < size && h->data_offset >= head.size()))
+    return std::nullopt;
   // The rows must all be there, as CheckBinarySize requires; bytes after
   // them are allowed, as there.
   const uint64_t count = h->elements[0].count;

@@ -146,6 +146,32 @@ TEST(ReadPackedXyzPly, KeepsTheGeneralReadersLimitsAndMissingFileError) {
   EXPECT_FALSE(ReadPackedXyzPly(dir.path()).has_value()) << "a directory";
 }
 
+// Headers whose end meets the 64 KiB the direct read parses first: the
+// newline after end_header just inside, just outside, and a "\r\n" split
+// across the edge. The general reader refuses a header past 64 KiB; the
+// direct one may neither accept such a header nor shift the rows.
+TEST(ReadPackedXyzPly, AgreesAtTheEdgeOfItsFirstRead) {
+  TempDir dir;
+  const std::size_t n = 100, head = 64 * 1024;
+  const std::string rows = Rows(n, 6);
+  for (const char* end_line : {"end_header\n", "end_header\r\n"}) {
+    const std::string end = end_line;
+    for (int shift = -3; shift <= 3; ++shift) {
+      std::string header = Header("", n);
+      const std::size_t target = head + shift;  // where the end line's last byte ends
+      std::string pad = "comment ";
+      while (header.size() + pad.size() + 1 + end.size() < target) pad += 'p';
+      if (header.size() + pad.size() + 1 + end.size() != target) continue;
+      header += pad + "\n" + end;
+      const std::string bytes = header + rows;
+      const std::string path = dir.File("edge.ply");
+      WriteBytes(path, bytes);
+      SCOPED_TRACE(std::to_string(shift) + (end.size() == 12 ? " crlf" : " lf"));
+      ExpectSameAsGeneral(path, bytes);
+    }
+  }
+}
+
 // Every single-byte change of the header of a file in our writer's layout:
 // the direct read and the general one still agree.
 TEST(ReadPackedXyzPly, AgreesWithTheGeneralReaderOnMutatedHeaders) {
