@@ -23,13 +23,10 @@ struct Accumulator {
   double sum = 0, sum2 = 0, min = INFINITY, max = -INFINITY;
 
   void Add(float d, const ToleranceBand& band) {
-    // Counted without branches (Contains() without its short circuit, too):
-    // most points of a failing part fall on either side of the band at
-    // random, which a branch mispredicts.
+    // Counted without branches: most points of a failing part fall on
+    // either side of the band at random, which a branch mispredicts.
     ++count;
-    const float lower = static_cast<float>(band.lower_mm),
-                upper = static_cast<float>(band.upper_mm);
-    const bool high = d > upper, in = (d >= lower) & (d <= upper);
+    const bool in = band.Contains(d), high = d > static_cast<float>(band.upper_mm);
     within += in;
     above += !in & high;
     below += !in & !high;

@@ -37,13 +37,15 @@ inline constexpr char kSurfaceCharacteristicName[] = "surface";
 
 // lower <= deviation <= upper, mm, signed (+ above the CAD surface).
 // Deviations are float32, so Contains() rounds the edges to float32 first:
-// a deviation that prints as the edge value is inside the band.
+// a deviation that prints as the edge value is inside the band. Both
+// edges are compared (&, not &&): no branch on the lower edge, which
+// mispredicts where a failing part's points fall on either side at random.
 struct ToleranceBand {
   double lower_mm = -0.1;
   double upper_mm = 0.1;
   bool Contains(float deviation_mm) const {
-    return deviation_mm >= static_cast<float>(lower_mm) &&
-           deviation_mm <= static_cast<float>(upper_mm);
+    return (deviation_mm >= static_cast<float>(lower_mm)) &
+           (deviation_mm <= static_cast<float>(upper_mm));
   }
 };
 

@@ -200,23 +200,21 @@ bool ReadAt(int fd, void* out, uint64_t n, uint64_t offset) {
   return true;
 }
 
-// Binary little-endian rows of float32 x, y, z alone, in the first element,
-// `vertex`; any other element empty (our writer's and PCL's `face 0`); and
-// an obj_info grid, if any, of as many cells as vertices (CheckGrid).
-bool PackedXyz(const PlyHeader& h) {
+// Binary little-endian rows of float32 x, y, z alone (FindXyz at offsets
+// 0, 4, 8 of a 12-byte row), in the first element, `vertex`; any other
+// element empty (our writer's and PCL's `face 0`); and a grid CheckGrid
+// accepts.
+bool PackedXyz(const PlyHeader& h, std::string_view name) {
   if (h.format != PlyFormat::kBinaryLittleEndian || h.elements.empty()) return false;
   const PlyElement& v = h.elements[0];
-  if (v.name != "vertex" || v.count == 0 || v.properties.size() != 3) return false;
-  const char* axis[] = {"x", "y", "z"};
-  for (int a = 0; a < 3; ++a) {
-    const PlyProperty& p = v.properties[a];
-    if (p.name != axis[a] || p.is_list || p.type != PlyType::kFloat32) return false;
-  }
+  if (v.name != "vertex" || v.count == 0 || v.FixedRowBytes() != uint64_t{12}) return false;
+  const absl::StatusOr<VertexLayout> layout = FindXyz(v, name);
+  if (!layout.ok()) return false;
+  for (int a = 0; a < 3; ++a)
+    if (layout->type[a] != PlyType::kFloat32 || layout->offset[a] != uint64_t{4} * a) return false;
   for (std::size_t e = 1; e < h.elements.size(); ++e)
     if (h.elements[e].count != 0) return false;
-  uint64_t cells = 0;
-  return !h.num_cols || !h.num_rows ||
-         (CheckedMul(*h.num_cols, *h.num_rows, &cells) && cells == v.count);
+  return CheckGrid(h, v.count, name).ok();
 }
 
 }  // namespace
@@ -235,7 +233,7 @@ std::optional<absl::StatusOr<PointCloud>> ReadPackedXyzPly(const std::string& pa
   const absl::StatusOr<PlyHeader> h = ParsePlyHeader(head, limits.max_points, path);
   // A header must end inside what was read, with its newline: a last line
   // cut at the end of `head` reads as "end_header" there and not in the file.
-  if (!h.ok() || !PackedXyz(*h) || (head.size() < size && h->data_offset >= head.size()))
+  if (!h.ok() || !PackedXyz(*h, path) || (head.size() < size && h->data_offset >= head.size()))
     return std::nullopt;
   // The rows must all be there, as CheckBinarySize requires; bytes after
   // them are allowed, as there.
