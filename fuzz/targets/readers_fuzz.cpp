@@ -3,7 +3,13 @@
 // buffer, so their targets call those parsers directly (ReadPointCloud and
 // ReadMesh read the file and hand its bytes to the same functions). STL and
 // OBJ go through ReadMesh on a scratch file, the programs' full path: the
-// strict check (mesh_precheck.h), then Assimp.
+// strict check (mesh_precheck.h), then Assimp. ply_cloud_direct checks the
+// direct PLY read (ReadPackedXyzPly, a scratch file) against ParsePlyCloud
+// on the same bytes: where it answers, the same cloud or the same error.
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+
 #include "core/io/io_mesh.h"
 #include "core/io/off_format.h"
 #include "core/io/pcd_format.h"
@@ -39,6 +45,28 @@ SURFINSPECT_FUZZ_TARGET(pcd) { (void)surfinspect::ParsePcd(bytes, CloudLimits(),
 #if !defined(SURFINSPECT_LIBFUZZER) || defined(FUZZ_ply_cloud)
 SURFINSPECT_FUZZ_TARGET(ply_cloud) {
   (void)surfinspect::ParsePlyCloud(bytes, CloudLimits(), "fuzz.ply");
+}
+#endif
+#if !defined(SURFINSPECT_LIBFUZZER) || defined(FUZZ_ply_cloud_direct)
+namespace {
+// Both readers' answers alike: the same status, or clouds equal bit for bit
+// (NaN payloads included) in their points and grid.
+bool SameAnswer(const absl::StatusOr<surfinspect::PointCloud>& a,
+                const absl::StatusOr<surfinspect::PointCloud>& b) {
+  if (a.ok() != b.ok()) return false;
+  if (!a.ok()) return a.status() == b.status();
+  return a->width == b->width && a->height == b->height && a->size() == b->size() &&
+         std::memcmp(a->points.data(), b->points.data(), a->size() * sizeof(a->points[0])) == 0;
+}
+}  // namespace
+SURFINSPECT_FUZZ_TARGET(ply_cloud_direct) {
+  const std::string path = surfinspect::fuzz::WriteScratchFile(bytes, "ply");
+  const auto direct = surfinspect::ReadPackedXyzPly(path, CloudLimits());
+  if (!direct) return;  // not its layout: the general reader answers
+  if (!SameAnswer(*direct, surfinspect::ParsePlyCloud(bytes, CloudLimits(), path))) {
+    std::fprintf(stderr, "ReadPackedXyzPly and ParsePlyCloud disagree\n");
+    std::abort();
+  }
 }
 #endif
 #if !defined(SURFINSPECT_LIBFUZZER) || defined(FUZZ_stl)
