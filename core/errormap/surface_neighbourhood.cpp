@@ -114,7 +114,7 @@ class CellNeighbourhood final : public SurfaceNeighbourhood {
  public:
   CellNeighbourhood(const ErrorMapResult& em, const PointCloud& cloud, float radius_mm,
                     float link_mm)
-      : em_(em), pts_(cloud.points), cell_(radius_mm), radius_(radius_mm), link_(link_mm) {
+      : pts_(cloud.points), cell_(radius_mm), radius_(radius_mm), link_(link_mm) {
     for (std::size_t i = 0; i < em.triangle_id.size(); ++i)
       if (Matched(em, i)) order_.push_back(static_cast<uint32_t>(i));
     std::vector<uint64_t> keys(order_.size());
@@ -199,7 +199,6 @@ class CellNeighbourhood final : public SurfaceNeighbourhood {
             if ((pts_[i] - pts_[order_[k]]).norm() <= reach) out.push_back(order_[k]);
         }
   }
-  const ErrorMapResult& em_;
   const std::vector<Eigen::Vector3f>& pts_;
   float cell_, radius_, link_;
   std::vector<uint32_t> order_, start_;
