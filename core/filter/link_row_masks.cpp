@@ -66,8 +66,8 @@ bool TransposeAndComputeMasks(const Eigen::Vector3f* pts, uint32_t w, RowSoA& cu
     if (next) {
       // The next row streams in while this one's links are tested: without
       // it the transpose is bound by load latency on an AMD EPYC (AVX2,
-      // measured). On an Intel Xeon with AVX-512 the hardware prefetcher
-      // keeps up, and these prefetches cost 3% of the pass (measured).
+      // measured). The AVX-512 pass prefetches group by group instead
+      // (link_row_pass.h).
       const char* bytes = reinterpret_cast<const char*>(next);
       for (std::size_t b = 0; b < std::size_t{w} * sizeof(Eigen::Vector3f); b += 64)
         __builtin_prefetch(bytes + b);
@@ -82,7 +82,7 @@ bool TransposeAndComputeMasks(const Eigen::Vector3f* pts, uint32_t w, RowSoA& cu
                              up ? up->c(2) : nullptr};
   uint64_t* const m[5] = {masks.valid, masks.west, masks.north_west, masks.north, masks.north_east};
   return avx512::TransposedRowBits(pts[0].data(), whole, c, up ? u : nullptr, diagonals, words,
-                                   link_distance_sq, m);
+                                   link_distance_sq, m, next ? next[0].data() : nullptr);
 }
 
 namespace {

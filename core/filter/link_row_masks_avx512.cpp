@@ -58,9 +58,9 @@ bool RowBits(const float* const cur[3], const float* const up[3], bool diagonals
 
 bool TransposedRowBits(const float* points, uint32_t whole, float* const cur[3],
                        const float* const up[3], bool diagonals, uint32_t words,
-                       float link_distance_sq, uint64_t* const masks[5]) {
+                       float link_distance_sq, uint64_t* const masks[5], const float* ahead) {
   return TransposedRowBitsOf<Avx512>(points, whole, cur, up, diagonals, words, link_distance_sq,
-                                     masks);
+                                     masks, ahead);
 }
 
 uint32_t Transpose(const float* f, uint32_t w, float* x, float* y, float* z) {

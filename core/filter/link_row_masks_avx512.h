@@ -16,10 +16,11 @@ bool RowBits(const float* const cur[3], const float* const up[3], bool diagonals
 // Transpose and RowBits in one pass: the pixels below `whole` (a multiple
 // of 16) are read from `points` (x, y, z interleaved) and stored to cur,
 // whose pixels from `whole` on the caller has filled; the same masks as
-// RowBits on the transposed row. Call only where AVX-512F and DQ run.
+// RowBits on the transposed row. `ahead` (or null) is the next row's points,
+// prefetched as the pass goes. Call only where AVX-512F and DQ run.
 bool TransposedRowBits(const float* points, uint32_t whole, float* const cur[3],
                        const float* const up[3], bool diagonals, uint32_t words,
-                       float link_distance_sq, uint64_t* const masks[5]);
+                       float link_distance_sq, uint64_t* const masks[5], const float* ahead);
 
 // As avx2::Transpose, in whole groups of 16 points (3 loads, 6 permutes
 // and 3 stores each). Call only where AVX-512F runs.
