@@ -69,6 +69,9 @@ struct ErrorMapRun {
   std::vector<std::string> failed, defects;  // for the summary
   // Stage times, s, merged into the report's "timing" block.
   double build_seconds = 0, plan_seconds = 0, png_seconds = 0;
+  // In-process with --db: the index the distances were found on, kept for
+  // the record's triangle summary instead of a second build.
+  std::shared_ptr<const MeshIndex> index;
 };
 
 // The server computes; PLY/CSV are written here from its deviations, the
@@ -222,8 +225,8 @@ void WriteQif(const ErrorMapArgs& a, const ErrorMapRun& run, std::size_t points)
 }
 
 // Records the error map as a part (client/cell/part_recorder.h). The
-// in-process path has each point's triangle; the remote one is matched again
-// on `mesh`.
+// in-process path has each point's triangle and its index (run.index); the
+// remote one is matched again on an index built here from `mesh`.
 void RecordErrorMap(ResultsStore& store, const ErrorMapArgs& a, const PointCloud& cloud_in_world,
                     const Eigen::Isometry3d& world_from_part, const TriangleMesh& mesh,
                     const nlohmann::json& plan_json, const ErrorMapRun& run) {
@@ -232,7 +235,7 @@ void RecordErrorMap(ResultsStore& store, const ErrorMapArgs& a, const PointCloud
   context.plan_hash = a.plan.empty() ? "" : client::PlanHash(plan_json);
   context.world_from_part = world_from_part;
   context.max_distance_mm = a.settings.max_distance_mm;
-  context.part = Take(MeshIndex::Build(mesh));
+  context.part = run.index ? run.index : Take(MeshIndex::Build(mesh));
   const std::string part_id = PartIdOf(a);
   PartRecord record =
       Take(client::MakePartRecord(context, part_id, run.report.dump(), "report", cloud_in_world,
@@ -279,6 +282,7 @@ double ErrorMapAndPly(const ErrorMapArgs& a, const PointCloud& cloud_in_world,
   }
   writing.wait();
   Check(ply);
+  if (!a.db.empty()) run.index = std::move(index);
   return ply_seconds;
 }
 
