@@ -112,7 +112,7 @@ bool TransposedPassOf(const float* points, uint32_t whole, float* const cur[3],
     for (uint32_t j = 0; j < 64; j += V::kWidth) {
       const uint32_t i = 64 * k + j;
       typename V::Vec px, py, pz;
-      if (ahead) {
+      if (ahead && i + V::kWidth <= whole) {  // the rows have the same width
         const char* next = reinterpret_cast<const char*>(ahead + 3 * std::size_t{i});
         for (std::size_t b = 0; b < 3 * sizeof(float) * V::kWidth; b += 64)
           __builtin_prefetch(next + b, 0, 2);  // read, into L2
