@@ -16,14 +16,27 @@ namespace surfinspect::link_row {
 
 // One row as structure-of-arrays, padded with NaN on both sides to a whole
 // number of 64-bit mask words: a link to a pixel outside the grid compares
-// NaN and is false with no bounds test.
-struct RowSoA {
-  std::vector<float> buf[3];
+// NaN and is false with no bounds test. Pixel 0 of each plane sits on a
+// 64-byte boundary, so a group of 16 pixels is one cache line to load or
+// store, not two.
+class RowSoA {
+ public:
   explicit RowSoA(uint32_t padded) {
-    for (auto& b : buf) b.assign(padded + 2, NAN);
+    for (int a = 0; a < 3; ++a) {
+      // A vector's floats are 16-byte aligned: at most 15 floats to skip.
+      buf_[a].assign(padded + 2 + 15, NAN);
+      const auto first = reinterpret_cast<std::uintptr_t>(buf_[a].data() + 1);
+      plane_[a] = buf_[a].data() + 1 + (64 - first % 64) % 64 / sizeof(float);
+    }
   }
-  float* c(int a) { return buf[a].data() + 1; }
-  const float* c(int a) const { return buf[a].data() + 1; }
+  RowSoA(const RowSoA&) = delete;
+  RowSoA& operator=(const RowSoA&) = delete;
+  float* c(int a) { return plane_[a]; }
+  const float* c(int a) const { return plane_[a]; }
+
+ private:
+  std::vector<float> buf_[3];
+  float* plane_[3];
 };
 
 // Per-row bit masks, bit j of word k for pixel 64k + j.
