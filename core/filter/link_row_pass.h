@@ -112,12 +112,12 @@ bool TransposedPassOf(const float* points, uint32_t whole, float* const cur[3],
     for (uint32_t j = 0; j < 64; j += V::kWidth) {
       const uint32_t i = 64 * k + j;
       typename V::Vec px, py, pz;
-      if (ahead && i + V::kWidth <= whole) {  // the rows have the same width
-        const char* next = reinterpret_cast<const char*>(ahead + 3 * std::size_t{i});
-        for (std::size_t b = 0; b < 3 * sizeof(float) * V::kWidth; b += 64)
-          __builtin_prefetch(next + b, 0, 2);  // read, into L2
-      }
       if (i + V::kWidth <= whole) {
+        if (ahead) {  // the same columns of the next row, which has this width
+          const char* next = reinterpret_cast<const char*>(ahead + 3 * std::size_t{i});
+          for (std::size_t b = 0; b < 3 * sizeof(float) * V::kWidth; b += 64)
+            __builtin_prefetch(next + b, 0, 2);  // read, into L2
+        }
         V::Transpose(points + 3 * std::size_t{i}, px, py, pz);
         V::Store(x + i, px), V::Store(y + i, py), V::Store(z + i, pz);
       } else {
