@@ -1,6 +1,6 @@
 // A call's cancellation flag, polled by the core loops, that also remembers
 // when it was raised, so the log can say how long the work took to stop
-// (the service promises well under 100 ms).
+// (the service promises well under a tenth of a second).
 #pragma once
 
 #include <atomic>

@@ -22,7 +22,7 @@ struct BackoffSettings {
 
 // Waits `seconds` or until `stop` is set, whichever comes first.
 using SleepFn = std::function<void(double seconds, const std::atomic<bool>& stop)>;
-// The real clock, checking `stop` every 50 ms.
+// The real clock, checking `stop` every 50 milliseconds.
 void SleepUnlessStopped(double seconds, const std::atomic<bool>& stop);
 
 // The wait before retry `retry` (0 = the first retry), s.

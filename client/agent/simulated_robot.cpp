@@ -98,7 +98,7 @@ Eigen::Vector2d DriftCenterXY(const TriangleMesh& part, const SurfaceDrift& drif
 }
 
 // An area the random defects stay out of (the drift's bump, so that the
-// drift is measured as itself); radius 0 = none.
+// drift is observed alone); radius 0 = none.
 struct KeepClear {
   Eigen::Vector2d xy = Eigen::Vector2d::Zero();
   double radius_mm = 0;

@@ -46,7 +46,7 @@ absl::StatusOr<PointCloud> SimulateGaugeScan(const CellConfig& cell, const Trian
 // middle of the part's x extent, y = 0: the demo part's ridge) with radius R
 // mm (default 40; the bump is exp(-2) of its height at R). The random
 // defects of a drifting run stay clear of the bump, so that the drift is
-// measured as itself.
+// observed alone.
 struct SurfaceDrift {
   enum class Kind { kNone, kBow, kShift } kind = Kind::kNone;
   double amount_mm = 0;                      // bow: per part; shift: the step

@@ -66,7 +66,7 @@ absl::Status WritePeopleReports(const std::string& dir, const PartOutputs& o) {
   return WriteReportHtml(dir + "/report.html", o, report, in_part);
 }
 
-// QIF 3.0 Results beside report.json; the measured points stay in errormap.ply.
+// QIF 3.0 Results beside report.json; the scanned points stay in errormap.ply.
 QifContext QifContextOf(const PartOutputs& o) {
   QifContext c;
   c.part_id = o.part_id;

@@ -1,4 +1,4 @@
-// surfinspect errormap: the signed deviation of a measured cloud from the
+// surfinspect errormap: the signed deviation of a scanned cloud from the
 // CAD mesh (paper §IV) as a coloured PLY, and optionally CSV, JSON report,
 // PNG and PDF report.
 #include <spdlog/spdlog.h>
@@ -286,7 +286,7 @@ double ErrorMapAndPly(const ErrorMapArgs& a, const PointCloud& cloud_in_world,
   return ply_seconds;
 }
 
-// The command's inputs, read and checked before anything is measured.
+// The command's inputs, read and checked before anything is computed.
 struct ErrorMapInputs {
   PointCloud cloud_in_world;
   Eigen::Isometry3d world_from_part;
@@ -319,7 +319,7 @@ ErrorMapInputs ReadInputs(const ErrorMapArgs& a) {
   in.world_from_part = Take(std::move(pose_read));
   if (!a.plan.empty()) in.plan_json = Take(client::ReadPlanJson(a.plan));
   in.mesh = Take(std::move(mesh_read));
-  // A bad plan is refused before anything is measured.
+  // A bad plan is refused before anything is computed.
   in.plan = a.plan.empty() ? PlanFromSettings(a.settings)
                            : Take(ParsePlanForMeshFile(in.plan_json, in.mesh, a.mesh, a.settings));
   in.read_seconds = Seconds(t0);

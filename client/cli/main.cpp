@@ -1,5 +1,5 @@
-// surfinspect: command-line front end. Runs each step in-process; with
-// --server (added per command by later steps) it calls surfinspectd.
+// surfinspect: command-line front end. Runs each step in-process; the
+// commands that take --server (client/cli/remote_args.h) call surfinspectd.
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 

@@ -1,4 +1,4 @@
-// How a viewpoint calibration's uncertainty reaches a measured point. The
+// How a viewpoint calibration's uncertainty reaches a scanned point. The
 // calibration (core/registration/calibration.h) reports the covariance of
 // x = [w (rad), t (mm)], the left perturbation of gauge_from_sensor in the
 // gauge frame: gauge_from_sensor' = exp(x) gauge_from_sensor. A point seen by

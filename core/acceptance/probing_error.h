@@ -3,7 +3,7 @@
 // by least squares (core/acceptance/sphere_fit.h) with a free radius, and
 //   PF = range of the radial residuals (largest minus smallest), after
 //        leaving out the `outlier_share` of points with the largest |residual|;
-//   PS = measured diameter - calibrated diameter.
+//   PS = fitted diameter - calibrated diameter.
 // Units mm, world frame. Uncertainties are standard (k = 1): the fit's
 // covariance (and, for PF, how finely the points resolve the extremes:
 // ExtremeResolution; for PS the artefact's calibration, added by the

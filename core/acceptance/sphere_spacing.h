@@ -1,5 +1,5 @@
 // Sphere-spacing error of a ball bar (VDI/VDE 2634 Part 2, §6.3; Part 3 for
-// spheres seen from different viewpoints): SD = measured centre distance -
+// spheres seen from different viewpoints): SD = fitted centre distance -
 // calibrated length, from two probing-error fits (probing_error.h). Its
 // standard uncertainty (k = 1) combines, along the bar's direction u:
 //   the two fits' centre covariances;
@@ -25,7 +25,7 @@ struct ViewCalibrationUncertainty {
 };
 
 struct SphereSpacing {
-  double length_mm = 0;  // measured centre distance
+  double length_mm = 0;  // distance of the two fitted centres
   double sd_mm = 0;      // length - calibrated length
   double u_sd_mm = 0;    // sqrt(u_fit^2 + u_calibration^2 + u_artefact^2)
   double u_fit_mm = 0, u_calibration_mm = 0, u_artefact_mm = 0;

@@ -79,9 +79,9 @@ struct MeshIndexSettings {
 
 // Hint certificates cost about one search per triangle to build and save
 // part of a search per coherent query: a one-shot call (build, query once,
-// exit) gains from them only with this many points per triangle or more.
-// On the bench's 150k-triangle torus, two threads: ~1 us a triangle to
-// build, ~67 ns a point saved, in scan order and in Morton order alike.
+// exit) gains from them only with this many points per triangle or more,
+// in scan order and in Morton order alike (bench/error_map_bench.cpp's
+// build and query rows on its 150k-triangle torus show the two costs).
 // An index that is kept (the server's cache, calibration's many ICP
 // iterations) builds them always.
 constexpr double kCertificatePointsPerTriangle = 16;

@@ -2,14 +2,14 @@
 // result per characteristic: the whole surface ("surface", the plan's
 // default band), each region, each comparison point; and the part verdict.
 //
-//  * Region membership of a measured point is its closest CAD triangle's
+//  * Region membership of a scanned point is its closest CAD triangle's
 //    (ResolvedInspectionPlan); a region is judged on the matched points in it.
-//  * A comparison point's value is the mean signed deviation of the measured
+//  * A comparison point's value is the mean signed deviation of the scanned
 //    points whose closest CAD point lies within radius_mm of position_mm; it
-//    is unmeasured (failing) when there is none.
+//    has no value (failing) when there is none.
 //  * A surface or region passes when it has matched points and the fraction
 //    outside its band is at most allowed_fraction_outside; a point passes
-//    when it is measured and its value is inside its band.
+//    when it has a value and that value is inside its band.
 //  * The part passes when every characteristic passes, and, when the plan
 //    sets defects.max_count, at most that many defects were found.
 //
@@ -45,7 +45,7 @@ struct CharacteristicResult {
   // Over those points, mm; NaN when there are none. stddev is the population one.
   double min_mm = NAN, max_mm = NAN, mean_mm = NAN, stddev_mm = NAN, rms_mm = NAN;
   double fraction_within = NAN;
-  double value_mm = NAN;  // points only: the mean; NaN when unmeasured
+  double value_mm = NAN;  // points only: the mean; NaN when no point is near
 };
 
 struct CharacteristicsResult {

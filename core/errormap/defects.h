@@ -1,10 +1,10 @@
 // Defect detection on an error map: connected patches of the surface whose
 // robust local deviation exceeds a threshold, with an area, a centroid on
 // the CAD surface and a fitted peak depth. Defects are evidence next to the
-// measured values; they change none of them.
+// deviations and statistics; they change none of them.
 //
 // The steps, each from a standard source:
-//  1. Neighbourhoods on the surface: the measured points within a radius r
+//  1. Neighbourhoods on the surface: the scanned points within a radius r
 //     (2.5 sampling spacings) in 3D, searched in a pixel window on an
 //     organized grid and in a cell grid otherwise (merged views); see
 //     core/errormap/surface_neighbourhood.h. A window never straddles a
@@ -63,7 +63,7 @@ struct Defect {
   bool peak_fitted = false;   // false: the peak is the deepest median
   double fit_sigma_mm = NAN;  // the fitted Gaussian's s (lateral size)
   double fit_rms_mm = NAN;    // RMS residual of the fit
-  std::size_t points = 0;     // measured points in the patch
+  std::size_t points = 0;     // scanned points in the patch
   std::string region;         // first plan region containing triangle_id, or empty
 };
 
@@ -79,7 +79,7 @@ struct DefectSettings {
   // generous (1 mm at the demo's 0.25 mm pitch), so steep walls stay
   // linked, and still below the depth jumps between surfaces.
   double grid_link_spacings = 4.0;
-  // Fewer measured points within r: no robust estimate, never a defect. 8 of
+  // Fewer scanned points within r: no robust estimate, never a defect. 8 of
   // the ~20 a surface sampled at the spacing has; a surface seen at grazing
   // incidence (spacing > ~1.5x the estimate) gets no estimate either.
   int min_neighbours = 8;

@@ -35,7 +35,7 @@ ComponentStats Summarize(const std::vector<T>& values) {
 }
 
 // The verdict's counts of the matched deviations (none NaN) against +-tol.
-// Added up, not branched on: a measured part's deviations fall either side
+// Added up, not branched on: a scanned part's deviations fall either side
 // of the band at random, and a branch per point is mispredicted.
 void CountVerdict(const std::vector<float>& matched, double tol, Verdict& v) {
   std::size_t above = 0, below = 0;

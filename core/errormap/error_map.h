@@ -1,4 +1,4 @@
-// The error map (paper §IV): for every measured point, its signed distance
+// The error map (paper §IV): for every scanned point, its signed distance
 // to the closest CAD triangle, plus the statistics, histogram and tolerance
 // verdict an inspector reads from it.
 //
@@ -35,7 +35,7 @@ struct ErrorMapSettings {
   double max_distance_mm = 5.0;  // farther points are unmatched (NaN), like CloudCompare's
                                  // C2M max distance; > 0, inf allowed
   // Fraction of the matched points allowed outside +-tol for a pass. The
-  // default 0 is the strict metrology reading (every measured point within
+  // default 0 is the strict metrology reading (every matched point within
   // tolerance); raise it to tolerate residual noise that filtering kept.
   double allowed_fraction_outside = 0.0;
   int histogram_bins = 41;        // odd, so one bin is centred on 0; <= kMaxHistogramBins

@@ -26,8 +26,7 @@ static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__,
 // rows: one copy fewer); the first failure sticks and is reported by
 // Close(). Each write is handed to the disk at once (sync_file_range), so
 // the fsync before the rename (core/io/atomic_file.h) waits for the last
-// one only: a 23 MB error map's fsync otherwise waits about 11 ms with both
-// cores idle.
+// one only, not for the whole file's writeback.
 class BufferedFile {
  public:
   explicit BufferedFile(const std::string& path) : path_(path), f_(std::fopen(path.c_str(), "wb")) {
@@ -133,7 +132,7 @@ void EncodePlyRows(const PointCloud& points, const ErrorMapResult& result, std::
 // Each piece of the colour scale blends two colours, each channel rounded
 // from x + (y - x) w, halves away from zero; the constant pieces (beyond the
 // scale) blend a colour with itself at weight 0. DeviationColor picks the
-// piece and the weight by index: on measured deviations the sign and the
+// piece and the weight by index: on a part's deviations the sign and the
 // band go either way at random, and branches on them are mispredicted. A
 // piece holds x and y - x per channel as doubles (exact: small integers).
 struct Piece {

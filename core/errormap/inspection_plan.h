@@ -6,7 +6,7 @@
 //    selected by a box (a triangle is in it when its centroid is), by
 //    triangle ids, or by a named group of the CAD file; regions may overlap;
 //  * comparison points at taught positions, each judged on the mean signed
-//    deviation of the measured points whose closest CAD point lies within
+//    deviation of the scanned points whose closest CAD point lies within
 //    radius_mm of it;
 //  * defect detection rules (core/errormap/defects.h).
 //

@@ -1,8 +1,8 @@
 // The JSON objects of an inspection plan's results, as report.json
 // ("schema": "surfinspect.report/2") holds them; docs/inspection-plan.md
 // lists the fields. Millimetres, part frame; a number that does not exist
-// (the statistics of a characteristic without points, an unmeasured point's
-// value) is null.
+// (the statistics of a characteristic without points, a comparison point's
+// value with no point near it) is null.
 #pragma once
 
 #include <nlohmann/json.hpp>

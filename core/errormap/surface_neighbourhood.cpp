@@ -12,10 +12,10 @@ namespace {
 
 bool Matched(const ErrorMapResult& em, std::size_t i) { return em.triangle_id[i] != UINT32_MAX; }
 
-// Organized grid: the pixels of a square window whose measured points lie
+// Organized grid: the pixels of a square window whose scanned points lie
 // within reach, for the median; 8-neighbours within the link distance for
-// links. Measured (not closest CAD) points: a mixed pixel hanging between two
-// surfaces has its closest CAD point on the surface, but few measured points
+// links. Scanned (not closest CAD) points: a mixed pixel hanging between two
+// surfaces has its closest CAD point on the surface, but few scanned points
 // near it, so it gets no estimate of its own.
 class GridNeighbourhood final : public SurfaceNeighbourhood {
  public:
@@ -108,7 +108,7 @@ class GridNeighbourhood final : public SurfaceNeighbourhood {
   double spacing_;
 };
 
-// Unorganized: cells of edge `radius` over the measured points, so every
+// Unorganized: cells of edge `radius` over the scanned points, so every
 // neighbour within the radius is in the 27 cells around a point's own.
 class CellNeighbourhood final : public SurfaceNeighbourhood {
  public:

@@ -1,6 +1,6 @@
-// Neighbourhoods of the measured points of a scanned surface, for defect
+// Neighbourhoods of the points of a scanned surface, for defect
 // detection (core/errormap/defects.h): the matched points within a radius of
-// a point in 3D (measured coordinates, any frame), its links, and its
+// a point in 3D (scanned coordinates, any frame), its links, and its
 // footprint area on the CAD surface.
 //
 //  * Organized grid: searched in a square pixel window around the point
@@ -54,11 +54,11 @@ std::unique_ptr<SurfaceNeighbourhood> MakeCellNeighbourhood(const ErrorMapResult
                                                             float radius_mm, float link_mm);
 
 // The sampling spacing on the surface, mm. Organized: the median distance
-// from a sample of measured points to their right or lower neighbour pixel.
+// from a sample of scanned points to their right or lower neighbour pixel.
 // Unorganized: sqrt of the surface area per point, pi R^2 / (points within
 // R = 2 mm), median over a sample, so that overlapping views (interleaved,
 // nearest neighbours far closer than the sampling) count as the denser
-// sampling they are. 1 mm when nothing can be measured.
+// sampling they are. 1 mm when no spacing can be estimated.
 double EstimateSurfaceSpacing(const ErrorMapResult& error_map, const PointCloud& cloud);
 
 // The median of v: the report's one percentile definition at q = 0.5 (the

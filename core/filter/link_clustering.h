@@ -30,8 +30,8 @@ namespace surfinspect {
 // The defaults are the paper's: they remove every outlier and may drop some
 // good points, which is right before ICP (paper §III: fewer good points "will
 // not change the calibration accuracy"). Before an error map, where dents
-// must survive, use ForInspection(). Both measured on simulated demo scans,
-// see tests/core/filter/link_clustering_groundtruth_test.cpp.
+// must survive, use ForInspection(). Both are checked on simulated demo
+// scans in tests/core/filter/link_clustering_groundtruth_test.cpp.
 struct LinkClusteringSettings {
   // Two points link when |p - q| <= link_distance_mm (mm, finite, > 0). The
   // paper sets it "according to the resolution of area sensors", 0.1-0.5 mm.
@@ -54,8 +54,7 @@ struct LinkClusteringSettings {
   // ~73 deg and stays below the >= 1 mm gap of mixed (stripe) pixels from
   // the near surface: >= 99.9% of dent points kept, ~1% of stripe points
   // too (linked to the far surface), which is why it is not the default:
-  // before calibration those cost accuracy (measured on the demo gauge
-  // scans: worst translation error ~10 um at 0.5 mm, ~50 um at 0.85 mm).
+  // before calibration those stray points pull the fit and cost accuracy.
   static LinkClusteringSettings ForInspection() {
     LinkClusteringSettings s;
     s.link_distance_mm = 0.85;

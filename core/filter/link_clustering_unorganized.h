@@ -12,8 +12,8 @@
 // packed cell key (z, y, x major to minor): the cells x-2..x+2 of one
 // (y, z) row are then one contiguous range of the sorted cells, found by
 // cursors that only move forward. (A grid with cells of edge d needs only
-// 27 neighbours but must test every pair of points: ~10x slower on dense
-// scans, measured.)
+// 27 neighbours but must test every pair of points, far slower on dense
+// scans.)
 #pragma once
 
 #include <atomic>

@@ -65,9 +65,9 @@ bool TransposeAndComputeMasks(const Eigen::Vector3f* pts, uint32_t w, RowSoA& cu
     Transpose(pts, w, cur, isa);
     if (next) {
       // The next row streams in while this one's links are tested: without
-      // it the transpose is bound by load latency on an AMD EPYC (AVX2,
-      // measured). The AVX-512 pass prefetches group by group instead
-      // (link_row_pass.h).
+      // it the AVX2 transpose is bound by load latency, as
+      // bench/link_clustering_bench.cpp shows. The AVX-512 pass prefetches
+      // group by group instead (link_row_pass.h).
       const char* bytes = reinterpret_cast<const char*>(next);
       for (std::size_t b = 0; b < std::size_t{w} * sizeof(Eigen::Vector3f); b += 64)
         __builtin_prefetch(bytes + b);
@@ -204,8 +204,8 @@ void RunBounds(const RowMasks& m, uint32_t words, uint64_t* starts, uint64_t* en
 // lanes of a one-axis-at-a-time reduction (4 lanes, then lane 0-3 in pairs,
 // then the scalar tail), so the result is that reduction's bit for bit, the
 // sign of a zero included; interleaving the axes runs their three min/max
-// dependency chains side by side instead of one after another (measured:
-// the single chain made this 12% of the grid path). With AVX-512 the run
+// dependency chains side by side instead of one after another, which the
+// grid rows of bench/link_clustering_bench.cpp show. With AVX-512 the run
 // goes 16 lanes at a time, and through this reduction where a bound is zero.
 void BoundsOfLongRun(const RowSoA& row, uint32_t first, uint32_t last, float lo_out[3],
                      float hi_out[3], RowIsa isa) {

@@ -67,9 +67,8 @@ bool ComputeMasks(const RowSoA& cur, const RowSoA* up, bool diagonals, uint32_t 
 
 // Transpose, then ComputeMasks, with the same results; with AVX-512 in one
 // pass that takes each group of 16 points from registers instead of
-// storing and loading it again (a 1024x768 scan's rows alone on one core:
-// 0.74 -> 0.51 ms; the whole grid pass gains 3-4%, its loads of the scan
-// being the rest). `next`, when given, is the next row's w points,
+// storing and loading it again (bench/link_clustering_bench.cpp's grid rows
+// show the gain). `next`, when given, is the next row's w points,
 // prefetched where that helps. `isa` must be supported.
 bool TransposeAndComputeMasks(const Eigen::Vector3f* pts, uint32_t w, RowSoA& cur, const RowSoA* up,
                               bool diagonals, uint32_t words, float link_distance_sq,

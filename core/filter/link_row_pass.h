@@ -94,10 +94,9 @@ bool PassOf(const float* const cur[3], const float* const up[3], uint32_t words,
 // bits. `ahead`, when given, is the next row's points: each group prefetches
 // the same columns of it into L2, one row (12 KB for 1024 columns) ahead of
 // its loads. The scan is read from L3 or memory, and the hardware
-// prefetcher alone left the loads of the transpose stalled (a 1024x768
-// scan on the Xeon with AVX-512, the whole grid pass in turns with and
-// without: one core 1.81 -> 1.73 ms, two cores unchanged; prefetching the
-// next row in one burst at the row's start gained nothing).
+// prefetcher alone leaves the loads of the transpose stalled on one core
+// (bench/link_clustering_bench.cpp shows it); prefetching the next row in
+// one burst at the row's start gains nothing.
 template <class V, bool kAbove, bool kDiagonals>
 bool TransposedPassOf(const float* points, uint32_t whole, float* const cur[3],
                       const float* const up[3], uint32_t words, float r2, uint64_t* const masks[5],

@@ -8,11 +8,12 @@ namespace surfinspect {
 
 // glibc maps every allocation above its threshold (128 KiB, rising to the
 // largest size freed so far) fresh from the kernel and unmaps it on free, so
-// each 9.4 MB cloud buffer is first-touched page by page: ~7 ms of page
-// faults per buffer on a 2-core EPYC (measured), most of the time
-// the Inspect stream spends receiving a view. This serves buffers up to
-// 32 MiB from the heap and trims the heap only when more than 256 MiB is
-// free, so the next call reuses the same pages. Resident memory then stays
+// each 9.4 MB cloud buffer is first-touched page by page, and those page
+// faults are most of the time the Inspect stream spends receiving a view
+// (the peers bench's service rows time one view streamed until received).
+// This serves buffers up to 32 MiB from the heap and trims the heap only
+// when more than 256 MiB is free, so the next call reuses the same pages.
+// Resident memory then stays
 // near its high-water mark, which the point and message limits bound.
 // Call it once, first thing in main. Returns false if glibc refused.
 bool ReuseFreedLargeBuffers();

@@ -6,9 +6,9 @@
 
 namespace surfinspect {
 
-// A fresh 4 KiB page costs a page fault on first touch: about 3 ms per MB on
-// this project's 2-core VMs (144 MB of std::vector touched in 400-430 ms),
-// a third of `surfinspect errormap`'s wall time on 10^6 points. With
+// A fresh 4 KiB page costs a page fault on first touch, a large share of
+// `surfinspect errormap`'s wall time on 10^6 points (the peers bench's
+// command rows time that command, process start to exit). With
 // transparent huge pages in "madvise" mode (the kernel default), one fault
 // maps 2 MiB instead. This grows glibc's heap once by `reserve_bytes` of
 // address space (not memory: pages are still mapped on first touch), marks

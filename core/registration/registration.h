@@ -48,8 +48,8 @@ absl::Status FilterViews(std::vector<ViewScan>& views, const LinkClusteringSetti
                          const FilteredViewSink& on_view = nullptr);
 
 // Fails on an invalid cloud, a non-rigid transform, or more than 65535 views;
-// Cancelled when `cancel` is raised (polled before each view: a 1024x768
-// view takes 9-50 ms here, most of it first touching the merged buffers).
+// Cancelled when `cancel` is raised (polled before each view: a view's work
+// is mostly first touching the merged buffers, too long to run uncancelled).
 absl::StatusOr<MergedCloud> RegisterToWorld(const std::vector<ViewScan>& views,
                                             const std::atomic<bool>* cancel = nullptr);
 

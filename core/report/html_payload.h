@@ -1,4 +1,4 @@
-// The compact point payload of the HTML report: which measured points the
+// The compact point payload of the HTML report: which scanned points the
 // page shows and how they are packed.
 //
 // Thinning: when a cloud has more than max_points finite points, the page

@@ -1,6 +1,6 @@
 // report.html: one self-contained page per part that opens from the results
 // folder with no server and no network. Beside a three.js viewer of the
-// measured points (part frame, coloured with the error map's palette, grey
+// scanned points (part frame, coloured with the error map's palette, grey
 // where unmatched; the CAD mesh as a translucent overlay that can be
 // switched off; defects marked by their ids) it shows the part verdict, the
 // characteristics (failed first), the defects, the histogram, the

@@ -25,7 +25,7 @@ struct PdfReportInput {
   std::string cell;                                  // "" = not given
   std::string time_utc;                              // e.g. "2026-12-01 11:40:00 UTC"; "" = now
   const nlohmann::json* report = nullptr;            // report.json, or the errormap report
-  const PointCloud* points_in_part = nullptr;        // the measured cloud, part frame, mm
+  const PointCloud* points_in_part = nullptr;        // the scanned cloud, part frame, mm
   const std::vector<float>* deviation_mm = nullptr;  // per point of points_in_part
 };
 

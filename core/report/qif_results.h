@@ -22,15 +22,15 @@
 //     bi-directional tolerance").
 //   - Value of a surface profile is the zone width 2 * max(|min|, |max|):
 //     the width of the narrowest zone centred on the nominal surface that
-//     holds every measured point, the same quantity as ToleranceValue (QIF's
-//     Value is "the measured value" of the toleranced quantity). The signed
+//     holds every scanned point, the same quantity as ToleranceValue (QIF's
+//     Value is the actual value of the toleranced quantity). The signed
 //     extremes go to WorstPositiveDeviation / WorstNegativeDeviation. A
 //     point profile's Value is the report's value_mm (mean signed deviation).
 //     A characteristic without points has no Value.
 //   - Status PASS/FAIL per characteristic is the report's verdict (which may
 //     allow a fraction of points outside the band, so a passing surface can
 //     have Value > ToleranceValue); InspectionStatus is the part's verdict.
-//   - The measured points stay in the PLY file: MeasurementResults'
+//   - The scanned points stay in the PLY file: MeasurementResults'
 //     ExternalFileReference names it (URI relative to the QIF file).
 #pragma once
 
@@ -47,7 +47,7 @@ struct QifContext {
   std::string cell;        // the cell's name (MeasurementDevice Name); required
   std::string part_model;  // the part type, e.g. its CAD file name; empty: "part of cell <cell>"
   std::string sensor = "robot-carried 2.5D area sensor";  // MeasurementDevice Description
-  std::string points_uri = "errormap.ply";  // measured points, relative to the QIF file
+  std::string points_uri = "errormap.ply";  // scanned points, relative to the QIF file
   std::size_t points_count = 0;             // points in that file
   std::string points_frame = "world";       // the frame of its coordinates
   std::string time_created;                 // xs:dateTime (UTC, "...Z"); empty: omitted

@@ -61,7 +61,7 @@ enum class PixelLabel : uint8_t {
 struct SimulatedScan {
   PointCloud cloud_in_sensor;      // organized width x height, mm
   std::vector<PixelLabel> labels;  // per pixel
-  // Per pixel: signed deviation of the measured (true, deformed) surface from
+  // Per pixel: signed deviation of the simulated (true, deformed) surface from
   // the CAD surface along its normal before noise, mm (+ above, - below);
   // NaN for no-data, pulse and stripe pixels.
   std::vector<float> true_deviation_mm;

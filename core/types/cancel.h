@@ -25,9 +25,9 @@ inline bool CancelledAt(std::size_t i, const std::atomic<bool>* cancel) {
 
 // Sets `v` to n copies of `value`, written slice by slice with `cancel`
 // polled between slices; false (and `v` partly filled) when cancelled. A
-// fresh buffer's first touch costs about 3 ms of page faults per MB on this
-// project's VMs, so one std::vector::assign of a 10^7-point result runs
-// longer than a cancelled call may.
+// fresh buffer's first touch costs a page fault per 4 KiB, so one
+// std::vector::assign of a 10^7-point result runs longer than a cancelled
+// call may.
 template <typename T>
 bool FillUnlessCancelled(std::vector<T>& v, std::size_t n, const T& value,
                          const std::atomic<bool>* cancel) {

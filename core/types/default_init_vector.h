@@ -1,10 +1,9 @@
 // A std::vector whose vector(n) and resize(n) leave new elements
 // default-initialized: for a trivial type, unwritten, where std::vector
 // zeroes them. A large fresh buffer costs a page fault per 4 KiB on first
-// touch (about 110 ms for 42 MB on this project's VMs); zeroing pays that at
-// allocation, in one serial call that cannot poll for cancellation. Left
-// unwritten, the faults happen in the pass that fills the buffer, which
-// polls, and in parallel if that pass is.
+// touch; zeroing pays that at allocation, in one serial call that cannot
+// poll for cancellation. Left unwritten, the faults happen in the pass that
+// fills the buffer, which polls, and in parallel if that pass is.
 #pragma once
 
 #include <memory>

@@ -2,7 +2,7 @@
 // page's data (<script id="si-data">, JSON) and payload (<script
 // id="si-payload">, base64 of little-endian typed arrays) and shows, by
 // data.kind:
-// - 'report' (report.html, core/report/html_report.h): the measured points
+// - 'report' (report.html, core/report/html_report.h): the scanned points
 //   in the part frame, coloured by the error map's palette index computed in
 //   C++ (core/report/html_payload.h), the CAD mesh as a translucent overlay,
 //   the defects with their ids;
@@ -29,10 +29,11 @@ window.addEventListener('error', (e) => state.errors.push(String(e.message)));
 const data = JSON.parse(document.getElementById('si-data').textContent);
 const RUN = 84; // core/report/deviation_palette.h
 // Software WebGL (SwiftShader: headless Chromium, and desktops without a GPU)
-// draws about 1 us per point, so 1 M points take about a second a frame on a
-// 2-core machine. The first frame, and every frame while the camera moves,
-// therefore draw a prefix of the payload, which core/report/
-// progressive_order.h spreads evenly over the part, with the points enlarged
+// draws points too slowly for a full frame of a million to follow the camera
+// (bench/report_viewer_bench.py prints a preview and a full frame's cost).
+// The first frame, and every frame while the camera moves, therefore draw a
+// prefix of the payload, which core/report/progressive_order.h spreads
+// evenly over the part, with the points enlarged
 // to close the gaps; the full set is drawn once the camera has rested for
 // REFINE_MS. Clouds of at most 1.5 x PREVIEW_POINTS are always drawn whole.
 const PREVIEW_POINTS = 250000;
@@ -306,7 +307,7 @@ function render(view) {
 }
 
 // Moves the camera to look at `target` from `target + dir * distance`,
-// animated over 500 ms unless `animate` is false.
+// animated over half a second unless `animate` is false.
 function moveCamera(view, target, position, animate) {
   const { camera, controls } = view;
   const from = { t: controls.target.clone(), p: camera.position.clone() };
