@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Runs the benchmarks: the peer comparison table (peers_bench, which writes
 # RESULTS_DIR/latest.md), then each Google Benchmark executable with short
-# minimum times, their console output kept in RESULTS_DIR/gbench-*.txt.
+# minimum times, their console output kept in RESULTS_DIR/gbench-*.txt, then
+# the stand-alone benches, each kept as RESULTS_DIR/NAME.txt. Every program
+# bench/CMakeLists.txt builds is run here.
 # Fails loudly on the first error. Budget: < 10 minutes on 2 cores.
 #   bench/run_all.sh BIN_DIR RESULTS_DIR
 set -euo pipefail
@@ -21,8 +23,8 @@ log "peer comparison table -> $RESULTS_DIR/latest.md"
 # The per-kernel Google Benchmarks, short: the table above is the record.
 # The service rows (ErrorMap over loopback, streaming) live in peers_bench.
 if [ "${BENCH_SKIP_GBENCH:-0}" != 1 ]; then
-  for b in link_clustering_bench scan_simulator_bench report_bench html_report_bench verify_bench \
-           results_store_bench; do
+  for b in link_clustering_bench error_map_bench scan_simulator_bench report_bench html_report_bench \
+           verify_bench results_store_bench; do
     [ -x "$BIN_DIR/$b" ] || die "$BIN_DIR/$b not built"
     log "$b"
     tmp=$(mktemp "$RESULTS_DIR/.gbench-$b.XXXXXX")
@@ -39,6 +41,13 @@ for b in inspection_plan_bench; do
   "$BIN_DIR/$b" >"$tmp" || { rm -f "$tmp"; die "$b failed"; }
   mv "$tmp" "$RESULTS_DIR/$b.txt"
 done
+# result.qif and the cell-agent's MQTT listeners against a mosquitto it
+# starts on a loopback port, kept as RESULTS_DIR/plant_integration.txt.
+[ -x "$BIN_DIR/plant_integration_bench" ] || die "$BIN_DIR/plant_integration_bench not built"
+log "plant_integration_bench"
+tmp=$(mktemp "$RESULTS_DIR/.plant_integration.XXXXXX")
+"$BIN_DIR/plant_integration_bench" >"$tmp" || { rm -f "$tmp"; die "plant_integration_bench failed"; }
+mv "$tmp" "$RESULTS_DIR/plant_integration.txt"
 # report.html in headless Chromium: time to interactive and frame times.
 if command -v chromium >/dev/null; then
   log "report_viewer_bench"
