@@ -12,6 +12,7 @@
 #include <random>
 
 #include "bench/wavy_sheet.h"
+#include "core/pipeline/inspection_report.h"
 #include "core/report/html_report.h"
 
 namespace {
@@ -22,7 +23,7 @@ struct Part {
   TriangleMesh mesh = bench::WavySheet(50, 300);  // 5000 triangles
   PointCloud points;
   std::vector<float> deviation;
-  nlohmann::json report;
+  InspectionReport report;
 };
 
 // 2 M points on the sheet (1414 x 1414 grid, 0.21 mm pitch), noise of
@@ -44,14 +45,15 @@ const Part& Get() {
       }
     p.points.width = static_cast<uint32_t>(p.points.points.size());
     p.points.height = 1;
-    p.report = {{"schema", "surfinspect.report/2"},
-                {"verdict", "fail"},
-                {"color_range_mm", 0.5},
-                {"tolerance", {{"band_mm", 0.1}, {"reason", "bench"}}},
-                {"points", {{"count", p.points.size()}}},
-                {"statistics", {{"min_mm", -0.45}, {"max_mm", 0.07}}},
-                {"histogram", {{"min_mm", -0.5}, {"max_mm", 0.5}, {"counts", {1, 2, 3}}}},
-                {"defects", {{{"id", 1}, {"kind", "dent"}, {"centroid_mm", {30, 0, 0}}}}}};
+    p.report = *DecodeReport(
+        nlohmann::json{{"schema", "surfinspect.report/2"},
+                       {"verdict", "fail"},
+                       {"color_range_mm", 0.5},
+                       {"tolerance", {{"band_mm", 0.1}, {"reason", "bench"}}},
+                       {"points", {{"count", p.points.size()}}},
+                       {"statistics", {{"min_mm", -0.45}, {"max_mm", 0.07}}},
+                       {"histogram", {{"min_mm", -0.5}, {"max_mm", 0.5}, {"counts", {1, 2, 3}}}},
+                       {"defects", {{{"id", 1}, {"kind", "dent"}, {"centroid_mm", {30, 0, 0}}}}}});
     return p;
   }();
   return part;

@@ -11,8 +11,8 @@
 #include <cstdio>
 #include <functional>
 
-#include "core/errormap/characteristics.h"
-#include "core/errormap/defects.h"
+#include "core/plan/characteristics.h"
+#include "core/plan/defects.h"
 #include "core/simulation/demo_cell.h"
 #include "core/types/transform.h"
 

@@ -11,7 +11,7 @@
 #include <cmath>
 #include <random>
 
-#include "core/errormap/error_map_output.h"
+#include "core/pipeline/inspection_report.h"
 #include "core/report/pdf_report.h"
 
 namespace {
@@ -88,7 +88,7 @@ nlohmann::json Report(const std::vector<float>& dev) {
 struct Part {
   PointCloud cloud;
   std::vector<float> deviation;
-  nlohmann::json report;
+  InspectionReport report;
 };
 
 const Part& Get(bool organized) {
@@ -114,7 +114,7 @@ const Part& Get(bool organized) {
   } else {
     p.cloud = PointCloud::Unorganized(std::move(pts));
   }
-  p.report = Report(p.deviation);
+  p.report = *DecodeReport(Report(p.deviation));
   return p;
 }
 

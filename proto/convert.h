@@ -4,6 +4,9 @@
 // the offending field in an InvalidArgument status; limits give
 // ResourceExhausted. Every "ToProto" builds a message from a core result,
 // so a handler reads: parse (FromProto) -> core -> convert (ToProto).
+// Implemented by concern: clouds, transforms, meshes and packed arrays in
+// convert.cpp; settings, the plan and the results in convert_settings.cpp,
+// convert_plan.cpp and convert_results.cpp.
 #pragma once
 
 #include <Eigen/Geometry>

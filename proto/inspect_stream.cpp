@@ -3,6 +3,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect::wire {
 namespace {
@@ -42,27 +43,24 @@ absl::Status InspectStreamReader::ConsumePart(v1::PartHeader* header) {
   // A mesh sent by hash is looked up now, so a miss fails before the client
   // streams its views; an inline mesh is the caller's, after the end marker.
   if (header->part().source_case() == v1::MeshRef::kSha256 && hooks_.resolve_mesh)
-    if (absl::Status st = hooks_.resolve_mesh(header->part(), "part.part"); !st.ok()) return st;
-  auto world_from_part = TransformFromProto(header->world_from_part(), "part.world_from_part");
-  if (!world_from_part.ok()) return world_from_part.status();
-  auto error_map = ErrorMapSettingsFromProto(header->error_map(), "part.error_map");
-  if (!error_map.ok()) return error_map.status();
-  auto filter = FilterSettingsFromProto(header->filter(), "part.filter",
-                                        LinkClusteringSettings::ForInspection());
-  if (!filter.ok()) return filter.status();
+    RETURN_IF_ERROR(hooks_.resolve_mesh(header->part(), "part.part"));
+  ASSIGN_OR_RETURN(auto world_from_part,
+                   TransformFromProto(header->world_from_part(), "part.world_from_part"));
+  ASSIGN_OR_RETURN(auto error_map,
+                   ErrorMapSettingsFromProto(header->error_map(), "part.error_map"));
+  ASSIGN_OR_RETURN(auto filter, FilterSettingsFromProto(header->filter(), "part.filter",
+                                                        LinkClusteringSettings::ForInspection()));
   // The plan's own values are checked here; against the mesh (triangle ids,
   // groups) by InspectPart once the mesh is indexed.
   if (header->has_plan()) {
-    auto plan = PlanFromProto(header->plan(), *error_map, "part.plan");
-    if (!plan.ok()) return plan.status();
-    part_.settings.plan = *std::move(plan);
+    ASSIGN_OR_RETURN(part_.settings.plan, PlanFromProto(header->plan(), error_map, "part.plan"));
   }
   part_.id = header->part_id();
   part_.mesh.Swap(header->mutable_part());
-  part_.world_from_part = *world_from_part;
+  part_.world_from_part = world_from_part;
   part_.settings.filter = !header->skip_filter();
-  part_.settings.filter_settings = *filter;
-  part_.settings.error_map = *error_map;
+  part_.settings.filter_settings = filter;
+  part_.settings.error_map = error_map;
   part_.return_deviations = header->return_deviations();
   part_.return_png = header->return_png();
   state_ = State::kExpectView;
@@ -74,21 +72,20 @@ absl::Status InspectStreamReader::ConsumeView(const v1::ViewHeader& view) {
   if (state_ == State::kInView) return IncompleteView("view", views_.empty() ? "" : "previous");
   if (state_ == State::kEnded) return InvalidField("view", "the stream has ended");
   const std::string field = absl::StrCat("view[", views_.size(), "]");
-  if (auto st = CheckCloudShape(view.width(), view.height(), field, limits_); !st.ok()) return st;
+  RETURN_IF_ERROR(CheckCloudShape(view.width(), view.height(), field, limits_));
   const uint64_t view_points = uint64_t{view.width()} * view.height();
   total_points_ += view_points;
   if (total_points_ > limits_.max_points)
     return absl::ResourceExhaustedError(
         absl::StrCat("part: ", total_points_, " points exceed the limit of ", limits_.max_points));
-  auto pose = TransformFromProto(view.world_from_sensor(), field + ".world_from_sensor");
-  if (!pose.ok()) return pose.status();
+  ASSIGN_OR_RETURN(auto pose,
+                   TransformFromProto(view.world_from_sensor(), field + ".world_from_sensor"));
   ViewScan scan;
   scan.name = view.name().empty() ? absl::StrCat("view", views_.size()) : view.name();
   // Before a byte of the view is buffered: a part that does not fit is
   // refused now, while the client still holds its data to send again.
-  if (hooks_.reserve_view)
-    if (absl::Status room = hooks_.reserve_view(view_points, scan.name); !room.ok()) return room;
-  scan.world_from_sensor = *pose;
+  if (hooks_.reserve_view) RETURN_IF_ERROR(hooks_.reserve_view(view_points, scan.name));
+  scan.world_from_sensor = pose;
   views_.push_back(std::move(scan));
   view_cloud_.Start(view.width(), view.height());
   state_ = State::kInView;
@@ -98,11 +95,10 @@ absl::Status InspectStreamReader::ConsumeView(const v1::ViewHeader& view) {
 absl::Status InspectStreamReader::ConsumeChunk(const v1::CloudChunk& chunk) {
   if (state_ != State::kInView) return InvalidField("chunk", "a chunk must follow a view header");
   const std::string field = absl::StrCat("view '", views_.back().name, "'");
-  if (auto st = view_cloud_.Add(chunk.xyz(), field); !st.ok()) return st;
+  RETURN_IF_ERROR(view_cloud_.Add(chunk.xyz(), field));
   if (!view_cloud_.complete()) return absl::OkStatus();
-  auto cloud = view_cloud_.Take(field);
-  if (!cloud.ok()) return cloud.status();
-  views_.back().cloud_in_sensor = *std::move(cloud);
+  ASSIGN_OR_RETURN(auto cloud, view_cloud_.Take(field));
+  views_.back().cloud_in_sensor = std::move(cloud);
   state_ = State::kExpectView;
   if (hooks_.view_received)
     hooks_.view_received(views_.back().name, views_.back().cloud_in_sensor.size());

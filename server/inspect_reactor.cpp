@@ -1,6 +1,7 @@
 #include "server/inspect_reactor.h"
 
 #include "absl/strings/str_cat.h"
+#include "core/report/error_map_png.h"
 #include "server/guarded.h"
 #include "server/status_mapping.h"
 

@@ -13,6 +13,7 @@
 #include "core/pipeline/inspection.h"
 #include "core/registration/calibration.h"
 #include "core/registration/registration.h"
+#include "core/report/error_map_png.h"
 #include "core/types/cancel.h"
 #include "core/types/transform.h"
 #include "server/cancel_signal.h"

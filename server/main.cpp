@@ -10,6 +10,7 @@
 #include "absl/strings/ascii.h"
 #include "core/io/atomic_file.h"
 #include "core/process/buffer_reuse.h"
+#include "core/types/status_macros.h"
 #include "server/run_server.h"
 
 namespace {
@@ -72,9 +73,8 @@ void AddFlags(CLI::App& app, ServerOptions& o, std::string& token_file, uint64_t
 
 // The bearer token from `token_file` (surrounding whitespace stripped).
 absl::StatusOr<std::string> ReadToken(const std::string& token_file) {
-  auto token = surfinspect::ReadFileToString(token_file, 4096);
-  if (!token.ok()) return token.status();
-  std::string stripped(absl::StripAsciiWhitespace(*token));
+  ASSIGN_OR_RETURN(auto token, surfinspect::ReadFileToString(token_file, 4096));
+  std::string stripped(absl::StripAsciiWhitespace(token));
   if (stripped.empty()) return absl::InvalidArgumentError(token_file + ": the token file is empty");
   return stripped;
 }

@@ -13,6 +13,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/io/atomic_file.h"
+#include "core/types/status_macros.h"
 #include "server/fault_hook.h"
 #include "server/memory_budget.h"
 
@@ -27,16 +28,13 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> Credentials(const Serve
   }
   if (o.tls_cert_file.empty() || o.tls_key_file.empty())
     return absl::InvalidArgumentError("TLS needs both --tls-cert and --tls-key");
-  auto cert = ReadFileToString(o.tls_cert_file, 1 << 20);
-  if (!cert.ok()) return cert.status();
-  auto key = ReadFileToString(o.tls_key_file, 1 << 20);
-  if (!key.ok()) return key.status();
+  ASSIGN_OR_RETURN(auto cert, ReadFileToString(o.tls_cert_file, 1 << 20));
+  ASSIGN_OR_RETURN(auto key, ReadFileToString(o.tls_key_file, 1 << 20));
   grpc::SslServerCredentialsOptions ssl;
-  ssl.pem_key_cert_pairs.push_back({*key, *cert});
+  ssl.pem_key_cert_pairs.push_back({key, cert});
   if (!o.tls_client_ca_file.empty()) {
-    auto ca = ReadFileToString(o.tls_client_ca_file, 1 << 20);
-    if (!ca.ok()) return ca.status();
-    ssl.pem_root_certs = *ca;
+    ASSIGN_OR_RETURN(auto ca, ReadFileToString(o.tls_client_ca_file, 1 << 20));
+    ssl.pem_root_certs = ca;
     ssl.client_certificate_request = GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY;
   }
   return grpc::SslServerCredentials(ssl);
@@ -64,10 +62,8 @@ absl::Status RunServer(const ServerOptions& options) {
     return absl::InvalidArgumentError("--threads and --max-calls must be >= 1");
   for (const std::string& spec : options.fault_inject)
     if (absl::Status st = ArmFault(spec); !st.ok()) return st;
-  auto creds = Credentials(options);
-  if (!creds.ok()) return creds.status();
-  auto metrics = Metrics::Create(options.metrics_listen);
-  if (!metrics.ok()) return metrics.status();
+  ASSIGN_OR_RETURN(auto creds, Credentials(options));
+  ASSIGN_OR_RETURN(auto metrics, Metrics::Create(options.metrics_listen));
 
   // Handle SIGTERM/SIGINT on one thread of our own: they are blocked (main
   // blocks them first thing; this repeats it for other callers), and the
@@ -81,12 +77,12 @@ absl::Status RunServer(const ServerOptions& options) {
   ServiceConfig config = options.service;
   config.memory_budget_bytes = MemoryBudgetBytes(options);
   config.max_message_bytes = uint64_t(options.max_message_mb) << 20;
-  InspectionService service(config, metrics->get());
+  InspectionService service(config, metrics.get());
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
   int port = 0;
-  builder.AddListeningPort(options.listen, *creds, &port);
+  builder.AddListeningPort(options.listen, creds, &port);
   builder.SetMaxReceiveMessageSize(options.max_message_mb << 20);
   builder.SetMaxSendMessageSize(options.max_message_mb << 20);
   // gRPC's own buffers (messages being received or sent) get a quarter of

@@ -193,8 +193,9 @@ PartReport CellAgent::InspectAndStore(const std::string& id, const std::vector<V
       outputs->viewpoints = ViewpointCalibrations(cell_);
     }
     absl::Status written =
-        outputs.ok() ? WritePartOutputs((fs::path(layout_.results) / id).string(), *outputs)
-                     : outputs.status();
+        outputs.ok()
+            ? WritePartOutputs((fs::path(layout_.results) / id).string(), *outputs, cell_.outputs)
+            : outputs.status();
     if (!written.ok()) {  // disk trouble: keep the part in the inbox for the next pass
       r = Report(PartOutcome::kRetryLater,
                  absl::StrCat("cannot write results: ", written.message()));

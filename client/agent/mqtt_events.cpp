@@ -8,7 +8,10 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "client/cell/part_files.h"
+#include "core/pipeline/inspection_report.h"
 #include "core/report/qif_results.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect::client {
 namespace fs = std::filesystem;
@@ -94,8 +97,7 @@ absl::StatusOr<MqttSettings> MqttSettingsFromCell(const CellConfig& cell) {
 }
 
 absl::Status ValidateMqttSettings(const MqttSettings& s) {
-  auto broker = ParseMqttUrl(s.url);
-  if (!broker.ok()) return broker.status();
+  ASSIGN_OR_RETURN(auto broker, ParseMqttUrl(s.url));
   const std::string& p = s.topic_prefix;
   if (p.find_first_of("#+") != std::string::npos)
     return Bad(absl::StrCat("topic prefix \"", p, "\" contains a wildcard ('#' or '+')"));
@@ -103,7 +105,7 @@ absl::Status ValidateMqttSettings(const MqttSettings& s) {
     return Bad(absl::StrCat("topic prefix \"", p, "\" has an empty level"));
   if (s.keepalive_s < 5 || s.keepalive_s > 3600)
     return Bad(absl::StrCat("keep-alive ", s.keepalive_s, " s outside [5, 3600]"));
-  if (!broker->tls && !(s.tls_ca.empty() && s.tls_cert.empty() && s.tls_key.empty()))
+  if (!broker.tls && !(s.tls_ca.empty() && s.tls_cert.empty() && s.tls_key.empty()))
     return Bad(absl::StrCat("TLS files given but ", s.url, " is not mqtts://"));
   if (s.tls_cert.empty() != s.tls_key.empty())
     return Bad("a client certificate needs its key, and a key its certificate");
@@ -113,7 +115,7 @@ absl::Status ValidateMqttSettings(const MqttSettings& s) {
                                      {"certificate", s.tls_cert},
                                      {"key", s.tls_key},
                                      {"password file", s.password_file}})
-    if (auto st = NeedFile(option, path); !st.ok()) return st;
+    RETURN_IF_ERROR(NeedFile(option, path));
   return absl::OkStatus();
 }
 
@@ -143,37 +145,36 @@ std::string StartedPayload(const std::string& cell, const std::string& part_id,
 absl::StatusOr<std::string> ResultPayload(const std::string& cell, const std::string& part_id,
                                           const std::string& results_dir,
                                           const std::string& report_json, const std::string& time) {
-  const json report = json::parse(report_json, nullptr, false);
-  if (report.is_discarded() || !report.is_object() || !report.contains("characteristics"))
+  const absl::StatusOr<InspectionReport> report = ParseReport(report_json);
+  if (!report.ok() || report->verdict.empty())
     return absl::DataLossError(absl::StrCat(results_dir, "/report.json: not a report"));
   json failed = json::array();
-  for (const json& c : report["characteristics"])
-    if (c.value("verdict", "") != "pass")
-      failed.push_back({{"name", c.value("name", "")},
-                        {"type", c.value("type", "")},
-                        {"reason", c.value("reason", "")}});
+  for (const ReportCharacteristic& c : report->characteristics)
+    if (!c.passed()) failed.push_back({{"name", c.name}, {"type", c.type}, {"reason", c.reason}});
   json files = json::object();
   std::error_code ec;
   const fs::path dir = fs::absolute(results_dir, ec).lexically_normal();
-  for (const auto& [key, name] : {std::pair{"report", "report.json"},
-                                  {"qif", "result.qif"},
-                                  {"errormap_ply", "errormap.ply"},
-                                  {"errormap_png", "errormap.png"},
-                                  {"deviations_csv", "deviations.csv"}})
+  // The event's keys for the catalogue's files (client/cell/part_files.h).
+  for (const auto& [key, file] : {std::pair{"report", PartFile::kReport},
+                                  {"qif", PartFile::kQif},
+                                  {"errormap_ply", PartFile::kPly},
+                                  {"errormap_png", PartFile::kPng},
+                                  {"deviations_csv", PartFile::kCsv}}) {
+    const char* name = EntryOf(file).file_name;
     if (fs::exists(dir / name, ec)) files[key] = (dir / name).string();
-  const json& st = report.value("statistics", json::object());
+  }
   return json{
       {"schema", "surfinspect.event.result/1"},
       {"cell", cell},
       {"part_id", part_id},
       {"idempotency_key", QifUuid(absl::StrCat("result/", cell, "/", part_id, "/", report_json))},
       {"time", time},
-      {"verdict", report.value("verdict", "")},
-      {"characteristics", report["characteristics"].size()},
+      {"verdict", report->verdict},
+      {"characteristics", report->characteristics.size()},
       {"failed", failed},
-      {"defects", report.value("defects", json::array()).size()},
-      {"min_mm", st.value("min_mm", json())},
-      {"max_mm", st.value("max_mm", json())},
+      {"defects", report->defects.size()},
+      {"min_mm", JsonNumber(report->stats.min_mm)},
+      {"max_mm", JsonNumber(report->stats.max_mm)},
       {"files", files}}
       .dump();
 }

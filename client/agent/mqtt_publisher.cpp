@@ -15,6 +15,7 @@
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "core/io/atomic_file.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect::client {
 namespace fs = std::filesystem;
@@ -154,9 +155,8 @@ absl::Status Configure(MqttPublisher::State& s) {
   if (!o.username.empty()) {
     std::string password;
     if (!o.password_file.empty()) {
-      auto text = ReadFileToString(o.password_file, 4096);
-      if (!text.ok()) return text.status();
-      password = std::string(absl::StripAsciiWhitespace(text->substr(0, text->find('\n'))));
+      ASSIGN_OR_RETURN(auto text, ReadFileToString(o.password_file, 4096));
+      password = std::string(absl::StripAsciiWhitespace(text.substr(0, text.find('\n'))));
     }
     mosquitto_username_pw_set(s.mosq, o.username.c_str(),
                               o.password_file.empty() ? nullptr : password.c_str());
@@ -189,7 +189,7 @@ absl::StatusOr<std::unique_ptr<MqttPublisher>> MqttPublisher::Start(const MqttSe
                                                                     const std::string& results_dir,
                                                                     MqttLog log,
                                                                     double first_connect_s) {
-  if (auto st = ValidateMqttSettings(settings); !st.ok()) return st;
+  RETURN_IF_ERROR(ValidateMqttSettings(settings));
   static std::once_flag init;
   std::call_once(init, [] { mosquitto_lib_init(); });
   std::unique_ptr<MqttPublisher> p(new MqttPublisher());
@@ -203,7 +203,7 @@ absl::StatusOr<std::unique_ptr<MqttPublisher>> MqttPublisher::Start(const MqttSe
   s.log = std::move(log);
   s.mosq = mosquitto_new(ClientIdOf(settings, cell).c_str(), /*clean_session=*/false, &s);
   if (s.mosq == nullptr) return absl::ResourceExhaustedError("mqtt: cannot create a client");
-  if (auto st = Configure(s); !st.ok()) return st;
+  RETURN_IF_ERROR(Configure(s));
   const int rc =
       mosquitto_connect_async(s.mosq, s.broker.host.c_str(), s.broker.port, settings.keepalive_s);
   if (rc != MOSQ_ERR_SUCCESS)

@@ -15,6 +15,7 @@
 #include "core/io/io_point_cloud.h"
 #include "core/io/io_transform.h"
 #include "core/simulation/scan_simulator.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect::client {
 namespace fs = std::filesystem;
@@ -206,10 +207,9 @@ absl::StatusOr<PointCloud> SimulateGaugeScan(const CellConfig& cell, const Trian
                                              uint64_t seed) {
   ScanOptions opt = ScanOptionsOf(cell);
   opt.seed = seed * 1000003 + std::hash<std::string>{}(vp.name) % 1000;
-  auto scan = SimulateScan(gauge, vp.world_from_gauge, DriftedPose(cell, vp, drift),
-                           IntrinsicsOf(cell), opt);
-  if (!scan.ok()) return scan.status();
-  return std::move(scan->cloud_in_sensor);
+  ASSIGN_OR_RETURN(auto scan, SimulateScan(gauge, vp.world_from_gauge, DriftedPose(cell, vp, drift),
+                                           IntrinsicsOf(cell), opt));
+  return std::move(scan.cloud_in_sensor);
 }
 
 double SurfaceDrift::HeightAt(int k) const {
@@ -247,8 +247,7 @@ absl::StatusOr<SurfaceDrift> ParseSurfaceDrift(const std::string& spec) {
   } else {
     return bad("unknown kind '" + parts[0] + "'");
   }
-  if (parts.size() == 3)
-    if (auto st = ParsePlace(spec, parts[2], &d); !st.ok()) return st;
+  if (parts.size() == 3) RETURN_IF_ERROR(ParsePlace(spec, parts[2], &d));
   return d;
 }
 
@@ -256,8 +255,7 @@ absl::StatusOr<std::vector<std::string>> SimulateParts(const CellConfig& cell,
                                                        const std::string& inbox, int count,
                                                        uint64_t seed, const SurfaceDrift& drift,
                                                        const RobotDrift& robot) {
-  auto part = ReadMesh(cell.part_mesh);
-  if (!part.ok()) return part.status();
+  ASSIGN_OR_RETURN(auto part, ReadMesh(cell.part_mesh));
   std::mt19937_64 rng(seed);
   std::vector<std::string> ids;
   for (int k = 0, n = 1; k < count; ++n) {
@@ -267,12 +265,11 @@ absl::StatusOr<std::vector<std::string>> SimulateParts(const CellConfig& cell,
     ScanOptions opt = ScanOptionsOf(cell);
     KeepClear clear;
     if (drift.kind != SurfaceDrift::Kind::kNone)
-      clear = {DriftCenterXY(*part, drift), drift.radius_mm};
-    nlohmann::json truth = {{"defects", PlantDefects(*part, rng, &opt, clear)}};
+      clear = {DriftCenterXY(part, drift), drift.radius_mm};
+    nlohmann::json truth = {{"defects", PlantDefects(part, rng, &opt, clear)}};
     if (drift.kind != SurfaceDrift::Kind::kNone)
-      truth["drift"] = PlantDrift(*part, drift, k - 1, &opt);
-    if (auto st = DropPart(cell, *part, fs::path(inbox) / id, opt, truth, seed, n, robot); !st.ok())
-      return st;
+      truth["drift"] = PlantDrift(part, drift, k - 1, &opt);
+    RETURN_IF_ERROR(DropPart(cell, part, fs::path(inbox) / id, opt, truth, seed, n, robot));
     ids.push_back(id);
   }
   return ids;

@@ -1,6 +1,7 @@
 #include "client/agent/store_recorder.h"
 
 #include "absl/strings/str_cat.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect::client {
 
@@ -13,14 +14,12 @@ StoreRecorder::StoreRecorder(std::string db, RecordContext context, std::string 
 
 absl::Status StoreRecorder::Open() {
   if (store_) return absl::OkStatus();
-  auto store = OpenResultsStore(db_);
-  if (!store.ok()) return store.status();
-  store_ = *std::move(store);
+  ASSIGN_OR_RETURN(store_, OpenResultsStore(db_));
   return absl::OkStatus();
 }
 
 absl::Status StoreRecorder::CatchUp() {
-  if (auto st = Open(); !st.ok()) return st;
+  RETURN_IF_ERROR(Open());
   std::vector<std::string> skipped;
   auto written = CatchUpFromFiles(*store_, context_, results_root_, &skipped);
   for (const std::string& s : skipped) on_error_(absl::StrCat("not recorded: ", s));

@@ -8,6 +8,7 @@
 #include "absl/strings/str_format.h"
 #include "core/io/atomic_file.h"
 #include "core/registration/calibration.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect::client {
 namespace fs = std::filesystem;
@@ -76,7 +77,7 @@ absl::StatusOr<VerifyConfig> VerifyConfigOf(const CellConfig& cell) {
 
 absl::StatusOr<CellVerification> VerifyCell(const CellConfig& cell, const MeshIndex& gauge,
                                             const GaugeScanFn& scan, const DriftLimits& limits) {
-  if (auto st = ValidateDriftLimits(limits); !st.ok()) return st;
+  RETURN_IF_ERROR(ValidateDriftLimits(limits));
   for (const auto& vp : cell.viewpoints)
     if (!vp.world_from_sensor)
       return absl::FailedPreconditionError(absl::StrCat(
@@ -183,7 +184,7 @@ absl::StatusOr<std::string> KeepPreviousCalibration(const CellConfig& cell) {
   const fs::path p(cell.path);
   const std::string out =
       (p.parent_path() / absl::StrCat(p.stem().string(), ".calibration-", stamp, ".json")).string();
-  if (auto st = WriteStringAtomically(out, cell.raw.dump(2) + "\n"); !st.ok()) return st;
+  RETURN_IF_ERROR(WriteStringAtomically(out, cell.raw.dump(2) + "\n"));
   return out;
 }
 

@@ -10,6 +10,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/io/atomic_file.h"
 #include "core/io/io_transform.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect::client {
 namespace {
@@ -33,20 +34,19 @@ absl::StatusOr<CellViewpoint> ReadViewpoint(const std::string& path, const nlohm
   if (vp.name.empty() || vp.name.find('/') != std::string::npos)
     return Bad(where, "name must be non-empty and contain no '/'");
   if (v.contains("nominal_world_from_sensor")) {
-    auto t = TransformFromJsonValue(v["nominal_world_from_sensor"],
-                                    where + ".nominal_world_from_sensor");
-    if (!t.ok()) return t.status();
-    vp.nominal_world_from_sensor = *t;
+    ASSIGN_OR_RETURN(auto t, TransformFromJsonValue(v["nominal_world_from_sensor"],
+                                                    where + ".nominal_world_from_sensor"));
+    vp.nominal_world_from_sensor = t;
   }
   if (v.contains("world_from_gauge")) {
-    auto t = TransformFromJsonValue(v["world_from_gauge"], where + ".world_from_gauge");
-    if (!t.ok()) return t.status();
-    vp.world_from_gauge = *t;
+    ASSIGN_OR_RETURN(auto t,
+                     TransformFromJsonValue(v["world_from_gauge"], where + ".world_from_gauge"));
+    vp.world_from_gauge = t;
   }
   if (v.contains("world_from_sensor") && !v["world_from_sensor"].is_null()) {
-    auto t = TransformFromJsonValue(v["world_from_sensor"], where + ".world_from_sensor");
-    if (!t.ok()) return t.status();
-    vp.world_from_sensor = *t;
+    ASSIGN_OR_RETURN(auto t,
+                     TransformFromJsonValue(v["world_from_sensor"], where + ".world_from_sensor"));
+    vp.world_from_sensor = t;
   }
   if (v.contains("gauge_scan")) vp.gauge_scan = Resolve(path, v["gauge_scan"].get<std::string>());
   return vp;
@@ -112,6 +112,22 @@ absl::Status ReadSettings(const nlohmann::json& j, CellConfig& c) {
   return st;
 }
 
+// cell.json's "outputs": the catalogue names of the files each part gets
+// (client/cell/part_files.h).
+absl::StatusOr<PartFileSet> OutputsOf(const std::string& path, const nlohmann::json& list) {
+  std::vector<std::string> names;
+  if (!list.is_array())
+    return Bad(path, absl::StrCat("outputs must be a list of names (", PartFileNames(), ")"));
+  for (const nlohmann::json& name : list) {
+    if (!name.is_string())
+      return Bad(path, absl::StrCat("outputs holds a non-name: ", name.dump()));
+    names.push_back(name.get<std::string>());
+  }
+  absl::StatusOr<PartFileSet> set = ParsePartFileSet(names, "outputs");
+  if (!set.ok()) return Bad(path, set.status().message());
+  return *set;
+}
+
 // The cell's name from cell.json, or the name of the folder that holds it.
 absl::StatusOr<std::string> CellName(const std::string& path, const nlohmann::json& j) {
   std::string name = j.contains("name")
@@ -134,17 +150,15 @@ absl::StatusOr<std::string> CellName(const std::string& path, const nlohmann::js
 }  // namespace
 
 absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
-  auto text = ReadFileToString(path, 16 << 20);
-  if (!text.ok()) return text.status();
+  ASSIGN_OR_RETURN(auto text, ReadFileToString(path, 16 << 20));
   CellConfig c;
   c.path = path;
-  c.raw = nlohmann::json::parse(*text, nullptr, false);
+  c.raw = nlohmann::json::parse(text, nullptr, false);
   if (c.raw.is_discarded() || !c.raw.is_object()) return Bad(path, "not a JSON object");
   const nlohmann::json& j = c.raw;
   try {
-    auto name = CellName(path, j);
-    if (!name.ok()) return name.status();
-    c.name = *std::move(name);
+    ASSIGN_OR_RETURN(auto name, CellName(path, j));
+    c.name = std::move(name);
     if (!j.contains("part") || !j["part"].contains("mesh") ||
         !j["part"].contains("world_from_part"))
       return Bad(path, "needs part.mesh and part.world_from_part");
@@ -158,23 +172,23 @@ absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
     if (!j.contains("viewpoints") || !j["viewpoints"].is_array() || j["viewpoints"].empty())
       return Bad(path, "needs a non-empty viewpoints array");
     for (std::size_t i = 0; i < j["viewpoints"].size(); ++i) {
-      auto vp = ReadViewpoint(path, j, i);
-      if (!vp.ok()) return vp.status();
-      c.viewpoints.push_back(*std::move(vp));
+      ASSIGN_OR_RETURN(auto vp, ReadViewpoint(path, j, i));
+      c.viewpoints.push_back(std::move(vp));
     }
     if (auto st = ReadSettings(j, c); !st.ok()) return Bad(path, st.message());
     if (j.contains("plan")) {
       if (j["plan"].is_string()) {
         c.plan_source = Resolve(path, j["plan"].get<std::string>());
-        auto plan = ReadPlanJson(c.plan_source);
-        if (!plan.ok()) return plan.status();
-        c.plan = *std::move(plan);
+        ASSIGN_OR_RETURN(c.plan, ReadPlanJson(c.plan_source));
       } else if (j["plan"].is_object()) {
         c.plan_source = path;
         c.plan = j["plan"];
       } else {
         return Bad(path, "plan must be a file name or an object");
       }
+    }
+    if (j.contains("outputs")) {
+      ASSIGN_OR_RETURN(c.outputs, OutputsOf(path, j["outputs"]));
     }
     if (j.contains("server")) {
       const auto& s = j["server"];
@@ -194,9 +208,8 @@ absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
 }
 
 absl::StatusOr<nlohmann::json> ReadPlanJson(const std::string& path) {
-  auto text = ReadFileToString(path, 16 << 20);
-  if (!text.ok()) return text.status();
-  nlohmann::json j = nlohmann::json::parse(*text, nullptr, false);
+  ASSIGN_OR_RETURN(auto text, ReadFileToString(path, 16 << 20));
+  nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
   if (j.is_discarded() || !j.is_object()) return Bad(path, "plan: not a JSON object");
   return j;
 }
@@ -230,9 +243,8 @@ absl::Status WriteCellCalibrations(
       if (n == name) v["calibration"] = q;
   }
   // Keep the previous file, then replace atomically.
-  auto old = ReadFileToString(cell.path, 16 << 20);
-  if (!old.ok()) return old.status();
-  if (auto st = WriteStringAtomically(cell.path + ".bak", *old); !st.ok()) return st;
+  ASSIGN_OR_RETURN(auto old, ReadFileToString(cell.path, 16 << 20));
+  RETURN_IF_ERROR(WriteStringAtomically(cell.path + ".bak", old));
   return WriteStringAtomically(cell.path, j.dump(2) + "\n");
 }
 

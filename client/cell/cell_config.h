@@ -15,6 +15,11 @@
 //   plan                                    optional inspection plan: a path
 //                                           ("plan.json") or an inline object
 //                                           (docs/inspection-plan.md)
+//   outputs                                 optional list of the files each part
+//                                           gets, by catalogue name ("ply", "csv",
+//                                           "png", "pdf", "html", "qif";
+//                                           client/cell/part_files.h); default
+//                                           all but "csv". report.json always.
 //   server{target, tls_ca, tls_cert, tls_key, token_file}   optional
 //   mqtt{url, topic_prefix, ...}            optional plant events, read by
 //                                           client/agent/mqtt_events.h
@@ -28,6 +33,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "client/cell/part_files.h"
 #include "core/errormap/error_map.h"
 #include "core/filter/link_clustering.h"
 #include "core/pipeline/inspection.h"
@@ -60,7 +66,9 @@ struct CellConfig {
   // one); parsed against the part mesh by PlanOf. Unset: no plan.
   std::optional<nlohmann::json> plan;
   std::string plan_source;  // the file it came from, for messages
-  nlohmann::json raw;       // the whole file, kept for rewriting
+  // The files each part gets ("outputs": catalogue names, report.json always).
+  PartFileSet outputs = PartFileSet::Defaults();
+  nlohmann::json raw;  // the whole file, kept for rewriting
 };
 
 absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path);
@@ -73,7 +81,7 @@ InspectionSettings InspectionSettingsOf(const CellConfig& cell);
 absl::StatusOr<nlohmann::json> ReadPlanJson(const std::string& path);
 
 // The cell's plan parsed against `part` with `settings` as its defaults
-// (core/pipeline/plan_evaluation.h), or unset when the cell has none.
+// (core/plan/plan_evaluation.h), or unset when the cell has none.
 // InvalidArgument "<file>: plan.<field>: ..." for a bad plan.
 absl::StatusOr<std::optional<InspectionPlan>> PlanOf(const CellConfig& cell,
                                                      const TriangleMesh& part,

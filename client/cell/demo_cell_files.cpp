@@ -12,6 +12,7 @@
 #include "core/io/io_point_cloud.h"
 #include "core/io/io_transform.h"
 #include "core/simulation/acceptance_artefacts.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect::client {
 namespace {
@@ -29,11 +30,9 @@ absl::StatusOr<nlohmann::json> WriteGaugeScans(const std::string& dir, const Dem
   nlohmann::json views = nlohmann::json::array();
   for (std::size_t v = 0; v < cell.viewpoints.size(); ++v) {
     const DemoViewpoint& vp = cell.viewpoints[v];
-    auto gauge_scan = SimulateDemoGaugeScan(cell, v, scan);
-    if (!gauge_scan.ok()) return gauge_scan.status();
+    ASSIGN_OR_RETURN(auto gauge_scan, SimulateDemoGaugeScan(cell, v, scan));
     const std::string gauge_path = absl::StrCat("gauge_scans/", vp.name, ".pcd");
-    if (auto st = WritePointCloud(dir + "/" + gauge_path, gauge_scan->cloud_in_sensor); !st.ok())
-      return st;
+    RETURN_IF_ERROR(WritePointCloud(dir + "/" + gauge_path, gauge_scan.cloud_in_sensor));
     views.push_back(
         {{"name", vp.name},
          {"nominal_world_from_sensor", TransformToJsonValue(vp.nominal_world_from_sensor)},
@@ -67,17 +66,16 @@ absl::StatusOr<nlohmann::json> WritePart(const std::string& dir, const DemoCell&
          {"radius_mm", d.radius_mm},
          {"depth_mm", d.depth_mm}});
   for (const char* sub : {"/scans/", "/truth/"})
-    if (auto st = MakeDirectory(absl::StrCat(dir, sub, part.part_id)); !st.ok()) return st;
+    RETURN_IF_ERROR(MakeDirectory(absl::StrCat(dir, sub, part.part_id)));
   nlohmann::json scans = nlohmann::json::object();
   for (std::size_t v = 0; v < cell.viewpoints.size(); ++v) {
     const std::string& view = cell.viewpoints[v].name;
-    auto s = SimulateDemoPartScan(cell, part, v, scan);
-    if (!s.ok()) return s.status();
+    ASSIGN_OR_RETURN(auto s, SimulateDemoPartScan(cell, part, v, scan));
     const std::string path = absl::StrCat("scans/", part.part_id, "/", view, ".pcd");
-    if (auto st = WritePointCloud(dir + "/" + path, s->cloud_in_sensor); !st.ok()) return st;
+    RETURN_IF_ERROR(WritePointCloud(dir + "/" + path, s.cloud_in_sensor));
     if (auto st =
             WriteStringAtomically(absl::StrCat(dir, "/truth/", part.part_id, "/", view, ".json"),
-                                  ScanTruth(part.part_id, view, *s).dump());
+                                  ScanTruth(part.part_id, view, s).dump());
         !st.ok())
       return st;
     scans[view] = path;
@@ -146,13 +144,12 @@ nlohmann::json CellJson(const DemoCell& cell, nlohmann::json views) {
 absl::Status WriteAcceptanceScan(const std::string& dir, const DemoCell& cell,
                                  const AcceptanceScene& scene, const std::string& name,
                                  const std::string& view, const ScanOptions& scan) {
-  auto v = ViewIndex(cell, view);
-  if (!v.ok()) return v.status();
-  auto s = SimulateAcceptanceScan(cell, scene, name, cell.viewpoints[*v].world_from_sensor, scan);
-  if (!s.ok()) return s.status();
+  ASSIGN_OR_RETURN(auto v, ViewIndex(cell, view));
+  ASSIGN_OR_RETURN(auto s, SimulateAcceptanceScan(cell, scene, name,
+                                                  cell.viewpoints[v].world_from_sensor, scan));
   const std::string sub = absl::StrCat(dir, "/acceptance/scans/", name);
-  if (auto st = MakeDirectory(sub); !st.ok()) return st;
-  return WritePointCloud(absl::StrCat(sub, "/", view, ".pcd"), s->cloud_in_sensor,
+  RETURN_IF_ERROR(MakeDirectory(sub));
+  return WritePointCloud(absl::StrCat(sub, "/", view, ".pcd"), s.cloud_in_sensor,
                          PcdEncoding::kBinaryCompressed);
 }
 
@@ -170,7 +167,7 @@ absl::Status WriteAcceptance(const std::string& dir, const DemoCell& cell,
   }
   for (const auto& p : a.plates) scans.emplace_back(p.name, p.at.view);
   for (const auto& [name, view] : scans)
-    if (auto st = WriteAcceptanceScan(dir, cell, scene, name, view, scan); !st.ok()) return st;
+    RETURN_IF_ERROR(WriteAcceptanceScan(dir, cell, scene, name, view, scan));
   nlohmann::json j = ArtefactsToJson(a);
   j["simulation_truth"] = {
       {"sphere_diameter_mm", scene.true_sphere_diameter_mm},
@@ -188,21 +185,18 @@ absl::Status WriteAcceptance(const std::string& dir, const DemoCell& cell,
 absl::Status WriteDemoCell(const std::string& dir, const DemoCell& cell,
                            const DemoWriteOptions& options) {
   for (const char* sub : {"", "/gauge_scans", "/scans", "/truth"})
-    if (auto st = MakeDirectory(dir + sub); !st.ok()) return st;
-  if (auto st = WriteMesh(dir + "/part.stl", cell.part); !st.ok()) return st;
-  if (auto st = WriteMesh(dir + "/gauge.stl", cell.gauge); !st.ok()) return st;
-  auto views = WriteGaugeScans(dir, cell, options.scan);
-  if (!views.ok()) return views.status();
+    RETURN_IF_ERROR(MakeDirectory(dir + sub));
+  RETURN_IF_ERROR(WriteMesh(dir + "/part.stl", cell.part));
+  RETURN_IF_ERROR(WriteMesh(dir + "/gauge.stl", cell.gauge));
+  ASSIGN_OR_RETURN(auto views, WriteGaugeScans(dir, cell, options.scan));
   nlohmann::json parts = nlohmann::json::array();
   for (const DemoPart& part : MakeDemoParts(cell, options.parts, options.scan.seed)) {
-    auto entry = WritePart(dir, cell, part, options.scan);
-    if (!entry.ok()) return entry.status();
-    parts.push_back(*std::move(entry));
+    ASSIGN_OR_RETURN(auto entry, WritePart(dir, cell, part, options.scan));
+    parts.push_back(std::move(entry));
   }
-  if (auto st = WriteStringAtomically(dir + "/plan.json", PlanJson(cell).dump(2) + "\n"); !st.ok())
-    return st;
+  RETURN_IF_ERROR(WriteStringAtomically(dir + "/plan.json", PlanJson(cell).dump(2) + "\n"));
   if (auto st = WriteStringAtomically(dir + "/cell.json",
-                                      CellJson(cell, *std::move(views)).dump(2) + "\n");
+                                      CellJson(cell, std::move(views)).dump(2) + "\n");
       !st.ok())
     return st;
   if (auto st =

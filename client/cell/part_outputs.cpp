@@ -1,69 +1,30 @@
 #include "client/cell/part_outputs.h"
 
-#include <filesystem>
-#include <nlohmann/json.hpp>
+#include <cmath>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "core/errormap/error_map_output.h"
-#include "core/io/atomic_file.h"
-#include "core/report/html_report.h"
-#include "core/report/pdf_report.h"
+#include "client/cell/part_files.h"
+#include "core/pipeline/inspection_report.h"
+#include "core/report/error_map_png.h"
 #include "core/report/qif_results.h"
+#include "core/types/status_macros.h"
 #include "core/types/transform.h"
 #include "proto/convert.h"
 
 namespace surfinspect::client {
 namespace {
 
+// The figures the outputs read from the report's text.
 absl::Status FillFromReport(PartOutputs& o) {
-  const nlohmann::json j = nlohmann::json::parse(o.report_json, nullptr, false);
-  if (j.is_discarded()) return absl::DataLossError("report is not valid JSON");
-  try {
-    o.tolerance_mm = j.at("tolerance").at("band_mm").get<double>();
-    o.color_range_mm = j.at("color_range_mm").get<double>();
-    const auto& st = j.at("statistics");
-    o.min_mm = st.value("min_mm", 0.0);
-    o.max_mm = st.value("max_mm", 0.0);
-  } catch (const nlohmann::json::exception&) {
-    // Extremes are only for the summary line; colours need the two above.
-    if (!(o.tolerance_mm > 0)) return absl::DataLossError("report lacks tolerance.band_mm");
-  }
+  ASSIGN_OR_RETURN(const InspectionReport report, ParseReport(o.report_json));
+  if (!(report.tolerance.band_mm > 0)) return absl::DataLossError("report lacks tolerance.band_mm");
+  o.tolerance_mm = report.tolerance.band_mm;
+  o.color_range_mm = report.color_range_mm;
+  // Extremes are only for the summary line.
+  o.min_mm = std::isfinite(report.stats.min_mm) ? report.stats.min_mm : 0.0;
+  o.max_mm = std::isfinite(report.stats.max_mm) ? report.stats.max_mm : 0.0;
   return absl::OkStatus();
-}
-
-// report.pdf, its maps drawn in the part frame.
-absl::Status WritePartPdf(const std::string& path, const PartOutputs& o,
-                          const nlohmann::json& report, const PointCloud& in_part) {
-  PdfReportInput pdf;
-  pdf.part_id = o.part_id;
-  pdf.cell = o.cell;
-  pdf.report = &report;
-  pdf.points_in_part = &in_part;
-  pdf.deviation_mm = &o.deviation_mm;
-  return WritePdfReport(path, pdf);
-}
-
-// report.html: the merged points in the part frame, so they overlay the CAD.
-absl::Status WriteReportHtml(const std::string& path, const PartOutputs& o,
-                             const nlohmann::json& report, const PointCloud& in_part) {
-  HtmlReportInput in;
-  in.report = &report;
-  in.points_in_part = &in_part;
-  in.deviation_mm = &o.deviation_mm;
-  in.mesh_in_part = o.mesh_in_part.get();
-  in.context = {o.part_id, o.cell, o.viewpoints};
-  return WriteHtmlReport(path, in);
-}
-
-// report.pdf and report.html, drawn from one parse of the report and one
-// copy of the merged points in the part frame.
-absl::Status WritePeopleReports(const std::string& dir, const PartOutputs& o) {
-  const nlohmann::json report = nlohmann::json::parse(o.report_json, nullptr, false);
-  if (report.is_discarded()) return absl::DataLossError("report is not valid JSON");
-  const PointCloud in_part = TransformCloud(o.merged_in_world, o.world_from_part.inverse());
-  if (auto st = WritePartPdf(dir + "/report.pdf", o, report, in_part); !st.ok()) return st;
-  return WriteReportHtml(dir + "/report.html", o, report, in_part);
 }
 
 // QIF 3.0 Results beside report.json; the scanned points stay in errormap.ply.
@@ -71,22 +32,10 @@ QifContext QifContextOf(const PartOutputs& o) {
   QifContext c;
   c.part_id = o.part_id;
   c.cell = o.cell.empty() ? "cell" : o.cell;
-  c.points_uri = "errormap.ply";
+  c.points_uri = EntryOf(PartFile::kPly).file_name;
   c.points_count = o.merged_in_world.size();
   c.time_created = QifTimeNow();
   return c;
-}
-
-// QIF is mapped from a surfinspect.report/2 (its characteristics); a report
-// of another schema (from a server that predates it) gets no result.qif.
-absl::Status WriteQif(const std::string& path, const PartOutputs& o) {
-  auto xml = QifResultsXml(o.report_json, QifContextOf(o));
-  if (!xml.ok()) {
-    const nlohmann::json j = nlohmann::json::parse(o.report_json, nullptr, false);
-    const bool report2 = j.is_object() && j.value("schema", "") == "surfinspect.report/2";
-    return report2 ? xml.status() : absl::OkStatus();
-  }
-  return WriteStringAtomically(path, *xml);
 }
 
 }  // namespace
@@ -117,14 +66,13 @@ absl::StatusOr<PartOutputs> OutputsFromLocal(const std::string& part_id, const I
   o.world_from_part = world_from_part;
   o.verdict = r.plan.pass() ? "pass" : "fail";
   o.report_json = ErrorMapReportText(r.error_map, settings.error_map, r.plan);
-  auto png = ErrorMapPngBytes(r.merged.cloud_in_world, world_from_part, r.error_map, part, r.plan);
-  if (!png.ok()) return png.status();
-  o.png = *std::move(png);
+  ASSIGN_OR_RETURN(
+      o.png, ErrorMapPngBytes(r.merged.cloud_in_world, world_from_part, r.error_map, part, r.plan));
   o.merged_in_world = r.merged.cloud_in_world;
   o.deviation_mm = r.error_map.deviation_mm;
   o.failed = FailedLines(r.plan.characteristics);
   o.defects = DefectLines(r.plan.defects);
-  if (auto st = FillFromReport(o); !st.ok()) return st;
+  RETURN_IF_ERROR(FillFromReport(o));
   return o;
 }
 
@@ -146,7 +94,7 @@ absl::StatusOr<PartOutputs> OutputsFromRemote(const v1::InspectResult& r) {
   o.deviation_mm = wire::UnpackFloats(r.deviations());
   if (o.deviation_mm.size() != o.merged_in_world.size())
     return absl::DataLossError("server sent a deviation count that does not match the cloud");
-  if (auto st = FillFromReport(o); !st.ok()) return st;
+  RETURN_IF_ERROR(FillFromReport(o));
   return o;
 }
 
@@ -165,24 +113,30 @@ v1::PartHeader MakePartHeader(const std::string& part_id, const Eigen::Isometry3
   return header;
 }
 
-absl::Status WritePartOutputs(const std::string& dir, const PartOutputs& o) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) return absl::PermissionDeniedError(absl::StrCat(dir, ": ", ec.message()));
+absl::Status WritePartOutputs(const std::string& dir, const PartOutputs& o,
+                              const PartFileSet& files) {
+  ASSIGN_OR_RETURN(const InspectionReport report, ParseReport(o.report_json));
   // The PLY/CSV writers only read deviations, tolerance and colour range.
   ErrorMapResult view;
   view.deviation_mm = o.deviation_mm;
   view.tolerance_mm = o.tolerance_mm;
   view.color_range_mm = o.color_range_mm;
-  if (auto st = WriteErrorMapPly(dir + "/errormap.ply", o.merged_in_world, view, "world"); !st.ok())
-    return st;
-  if (auto st = WriteErrorMapCsv(dir + "/deviations.csv", o.merged_in_world, view); !st.ok())
-    return st;
-  if (auto st = WriteStringAtomically(dir + "/errormap.png", o.png); !st.ok()) return st;
-  if (auto st = WritePeopleReports(dir, o); !st.ok()) return st;
-  if (auto st = WriteQif(dir + "/result.qif", o); !st.ok()) return st;
-  // The report last: its presence means the part's results are complete.
-  return WriteStringAtomically(dir + "/report.json", o.report_json);
+  // The pictures are drawn in the part frame, so they overlay the CAD.
+  const PointCloud in_part = TransformCloud(o.merged_in_world, o.world_from_part.inverse());
+  PartFileInputs in;
+  in.part_id = o.part_id;
+  in.cell = o.cell;
+  in.points = &o.merged_in_world;
+  in.points_frame = "world";
+  in.points_in_part = &in_part;
+  in.error_map = &view;
+  in.report = &report;
+  in.report_text = o.report_json;
+  in.png = o.png;
+  in.mesh_in_part = o.mesh_in_part.get();
+  in.viewpoints = o.viewpoints;
+  in.qif = QifContextOf(o);
+  return WritePartFiles(dir, files, in);
 }
 
 }  // namespace surfinspect::client

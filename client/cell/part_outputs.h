@@ -1,9 +1,8 @@
-// What an inspected part leaves on disk, the same whether it was computed
-// in-process or by surfinspectd: report.json, errormap.ply (world frame,
-// deviation + colour per point), errormap.png, deviations.csv and
-// report.pdf (core/report/pdf_report.h) and report.html
-// (core/report/html_report.h, part frame), each written atomically
-// (temporary file, then rename).
+// An inspected part's results, the same whether it was computed in-process
+// or by surfinspectd, and its files in a results folder: the catalogue's
+// (client/cell/part_files.h) that the cell asks for, the PLY in the world
+// frame, the pictures in the part frame, each written atomically and
+// report.json last.
 #pragma once
 
 #include <memory>
@@ -11,7 +10,9 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "client/cell/part_files.h"
 #include "core/pipeline/inspection.h"
+#include "core/pipeline/inspection_report.h"
 #include "core/report/html_sections.h"
 #include "core/types/point_cloud.h"
 #include "surfinspect/v1/inspection.pb.h"
@@ -54,6 +55,7 @@ absl::StatusOr<PartOutputs> OutputsFromRemote(const ::surfinspect::v1::InspectRe
                                              const Eigen::Isometry3d& world_from_part,
                                              const InspectionSettings& settings);
 
-absl::Status WritePartOutputs(const std::string& dir, const PartOutputs& outputs);
+absl::Status WritePartOutputs(const std::string& dir, const PartOutputs& outputs,
+                              const PartFileSet& files = PartFileSet::Defaults());
 
 }  // namespace surfinspect::client

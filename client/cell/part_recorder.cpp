@@ -10,10 +10,12 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
+#include "client/cell/part_files.h"
 #include "core/history/part_record.h"
 #include "core/history/triangle_summary.h"
 #include "core/io/atomic_file.h"
 #include "core/io/io_transform.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect::client {
 namespace fs = std::filesystem;
@@ -38,10 +40,9 @@ absl::StatusOr<std::vector<TriangleStat>> Summary(const RecordContext& c, const 
                                                   const std::vector<float>& deviation_mm) {
   BatchQuerySettings q;
   q.max_distance_mm = c.max_distance_mm;
-  auto closest = QueryClosest(*c.part, world, c.world_from_part.inverse(), q);
-  if (!closest.ok()) return closest.status();
-  std::vector<uint32_t> ids(closest->size());
-  for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = (*closest)[i].triangle_id;
+  ASSIGN_OR_RETURN(auto closest, QueryClosest(*c.part, world, c.world_from_part.inverse(), q));
+  std::vector<uint32_t> ids(closest.size());
+  for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = (closest)[i].triangle_id;
   return SummarizeByTriangle(ids, deviation_mm,
                              static_cast<uint32_t>(c.part->mesh().num_triangles()));
 }
@@ -117,14 +118,12 @@ absl::StatusOr<PartRecord> MakePartRecord(const RecordContext& c, const std::str
   r.software_version = kSoftwareVersion;
   r.plan_hash = c.plan_hash;
   r.calibration_json = c.calibration_json.empty() ? "{}" : c.calibration_json;
-  if (auto st = FillFromReportJson(report_json, where, &r); !st.ok()) return st;
+  RETURN_IF_ERROR(FillFromReportJson(report_json, where, &r));
   if (!c.part) return r;
   r.num_triangles = static_cast<uint32_t>(c.part->mesh().num_triangles());
-  auto summary = triangle_id.empty()
-                     ? Summary(c, world, deviation_mm)
-                     : SummarizeByTriangle(triangle_id, deviation_mm, r.num_triangles);
-  if (!summary.ok()) return summary.status();
-  r.triangles = *std::move(summary);
+  ASSIGN_OR_RETURN(r.triangles, triangle_id.empty() ? Summary(c, world, deviation_mm)
+                                                    : SummarizeByTriangle(triangle_id, deviation_mm,
+                                                                          r.num_triangles));
   return r;
 }
 
@@ -133,29 +132,28 @@ absl::StatusOr<PartRecord> PartRecordFromFiles(const RecordContext& c, const std
   const std::string report_path = (fs::path(dir) / "report.json").string();
   auto report = ReadFileToString(report_path, std::size_t{64} << 20);
   if (!report.ok()) return report.status();
-  auto when = ModifiedUtc(report_path);
-  if (!when.ok()) return when.status();
+  ASSIGN_OR_RETURN(auto when, ModifiedUtc(report_path));
   PointCloud world;
   std::vector<float> deviation;
   if (c.part) {
-    const std::string ply = (fs::path(dir) / "errormap.ply").string();
-    if (auto st = ReadErrorMapPly(ply, &world, &deviation); !st.ok()) return st;
+    const std::string ply = (fs::path(dir) / EntryOf(PartFile::kPly).file_name).string();
+    RETURN_IF_ERROR(ReadErrorMapPly(ply, &world, &deviation));
   }
-  auto r = MakePartRecord(c, part_id, *report, report_path, world, deviation);
-  if (!r.ok()) return r.status();
-  r->inspected_utc = *when;
+  ASSIGN_OR_RETURN(auto r, MakePartRecord(c, part_id, *report, report_path, world, deviation));
+  r.inspected_utc = when;
   nlohmann::json files = {{"report", report_path}};
-  for (const char* name : {"errormap.ply", "errormap.png", "deviations.csv"})
+  for (PartFile file : {PartFile::kPly, PartFile::kPng, PartFile::kCsv}) {
+    const char* name = EntryOf(file).file_name;
     if (fs::exists(fs::path(dir) / name)) files[name] = (fs::path(dir) / name).string();
-  r->files_json = files.dump();
+  }
+  r.files_json = files.dump();
   return r;
 }
 
 absl::StatusOr<bool> RecordPartFromFiles(ResultsStore& store, const RecordContext& context,
                                          const std::string& part_id, const std::string& dir) {
-  auto record = PartRecordFromFiles(context, part_id, dir);
-  if (!record.ok()) return record.status();
-  return store.Record(*record);
+  ASSIGN_OR_RETURN(auto record, PartRecordFromFiles(context, part_id, dir));
+  return store.Record(record);
 }
 
 absl::StatusOr<int> CatchUpFromFiles(ResultsStore& store, const RecordContext& context,
@@ -170,17 +168,15 @@ absl::StatusOr<int> CatchUpFromFiles(ResultsStore& store, const RecordContext& c
   std::sort(ids.begin(), ids.end());
   int written = 0;
   for (const std::string& id : ids) {
-    auto there = store.Contains(context.cell, id);
-    if (!there.ok()) return there.status();
-    if (*there) continue;
+    ASSIGN_OR_RETURN(auto there, store.Contains(context.cell, id));
+    if (there) continue;
     auto record = PartRecordFromFiles(context, id, (fs::path(results_root) / id).string());
     if (!record.ok()) {  // this part's files: skip it; the store's trouble: stop
       if (skipped) skipped->push_back(absl::StrCat(id, ": ", record.status().message()));
       continue;
     }
-    auto w = store.Record(*record);
-    if (!w.ok()) return w.status();
-    written += *w ? 1 : 0;
+    ASSIGN_OR_RETURN(auto w, store.Record(*record));
+    written += w ? 1 : 0;
   }
   return written;
 }

@@ -21,6 +21,7 @@
 #include "core/io/io_point_cloud.h"
 #include "core/registration/calibration.h"
 #include "core/registration/registration.h"
+#include "core/types/status_macros.h"
 #include "proto/convert.h"
 #include "proto/packed_cloud.h"
 
@@ -66,8 +67,7 @@ WorldScanFn ScanSource(const AcceptanceArgs& a, const client::CellConfig& cell,
       return absl::FailedPreconditionError(name + ": viewpoint " + view +
                                            " is not a calibrated viewpoint of " + cell.path);
     const std::string path = a.scans + "/" + name + "/" + view + ".pcd";
-    auto cloud = ReadPointCloud(path);
-    if (!cloud.ok()) return cloud.status();
+    ASSIGN_OR_RETURN(auto cloud, ReadPointCloud(path));
     if (remote) {
       v1::RegisterRequest req;
       req.set_filter(true);
@@ -75,16 +75,14 @@ WorldScanFn ScanSource(const AcceptanceArgs& a, const client::CellConfig& cell,
       v1::ViewScan* v = req.add_views();
       v->set_name(view);
       wire::TransformToProto(*vp->world_from_sensor, v->mutable_world_from_sensor());
-      wire::CloudToRequestProto(*cloud, v->mutable_cloud());
-      auto resp = remote->Register(req, nullptr);
-      if (!resp.ok()) return resp.status();
-      return wire::CloudFromProto(resp->merged(), "merged", wire::Limits{});
+      wire::CloudToRequestProto(cloud, v->mutable_cloud());
+      ASSIGN_OR_RETURN(auto resp, remote->Register(req, nullptr));
+      return wire::CloudFromProto(resp.merged(), "merged", wire::Limits{});
     }
-    std::vector<ViewScan> views{{view, *std::move(cloud), *vp->world_from_sensor}};
-    if (auto st = FilterViews(views, ArtefactFilter()); !st.ok()) return st;
-    auto merged = RegisterToWorld(views);
-    if (!merged.ok()) return merged.status();
-    return std::move(merged->cloud_in_world);
+    std::vector<ViewScan> views{{view, std::move(cloud), *vp->world_from_sensor}};
+    RETURN_IF_ERROR(FilterViews(views, ArtefactFilter()));
+    ASSIGN_OR_RETURN(auto merged, RegisterToWorld(views));
+    return std::move(merged.cloud_in_world);
   };
 }
 

@@ -22,6 +22,7 @@ namespace {
 
 struct InspectArgs {
   std::string cell, scans, out, part_id, plan, db;
+  std::vector<std::string> outputs;  // catalogue names; empty: the cell's "outputs"
   double tolerance = 0;
   RemoteArgs remote;
 };
@@ -39,6 +40,8 @@ void Record(ResultsStore& store, const InspectArgs& a, const client::CellConfig&
 
 void Inspect(const InspectArgs& a) {
   const client::CellConfig cell = Take(client::ReadCellConfig(a.cell));
+  const client::PartFileSet files =
+      a.outputs.empty() ? cell.outputs : Take(client::ParsePartFileSet(a.outputs, "--outputs"));
   const std::unique_ptr<ResultsStore> store = a.db.empty() ? nullptr : OpenStore(a.db, false);
   const auto part_ptr = std::make_shared<const TriangleMesh>(Take(ReadMesh(cell.part_mesh)));
   const TriangleMesh& part = *part_ptr;
@@ -82,7 +85,7 @@ void Inspect(const InspectArgs& a) {
   outputs.world_from_part = cell.world_from_part;
   outputs.mesh_in_part = part_ptr;
   outputs.viewpoints = client::ViewpointCalibrations(cell);
-  Check(client::WritePartOutputs(a.out, outputs));
+  Check(client::WritePartOutputs(a.out, outputs, files));
   std::printf("%s: %s  (min %.3f mm, max %.3f mm)  -> %s\n", part_id.c_str(),
               outputs.verdict.c_str(), outputs.min_mm, outputs.max_mm, a.out.c_str());
   for (const std::string& line : outputs.failed) std::printf("  failed %s\n", line.c_str());
@@ -98,9 +101,12 @@ void AddInspectCommand(CLI::App& app) {
   cmd->add_option("--cell", a->cell, "cell.json (calibrated viewpoints, part mesh and pose)")
       ->required();
   cmd->add_option("--scans", a->scans, "folder with <viewpoint>.pcd scans of one part")->required();
-  cmd->add_option("--out", a->out,
-                  "results folder (report.json, report.html, errormap.ply/.png, deviations.csv)")
+  cmd->add_option("--out", a->out, "results folder; its files:\n" + client::PartFilesHelp())
       ->required();
+  cmd->add_option("--outputs", a->outputs,
+                  "the files to write besides report.json, by name (" + client::PartFileNames() +
+                      "); default: the cell's \"outputs\", else all but csv")
+      ->delimiter(',');
   cmd->add_option("--part-id", a->part_id, "default: the scans folder's name");
   cmd->add_option("--tolerance", a->tolerance, "override the cell's tolerance, mm (0 = keep)");
   cmd->add_option("--plan", a->plan,

@@ -8,6 +8,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/io/atomic_file.h"
 #include "core/io/mesh_hash.h"
+#include "core/types/status_macros.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "proto/convert.h"
 
@@ -36,16 +37,13 @@ absl::StatusOr<std::unique_ptr<RemoteClient>> RemoteClient::Connect(const Remote
     creds = grpc::InsecureChannelCredentials();
   } else {
     grpc::SslCredentialsOptions ssl;
-    auto ca = ReadFileToString(o.tls_ca_file, 1 << 20);
-    if (!ca.ok()) return ca.status();
-    ssl.pem_root_certs = *ca;
+    ASSIGN_OR_RETURN(auto ca, ReadFileToString(o.tls_ca_file, 1 << 20));
+    ssl.pem_root_certs = ca;
     if (!o.tls_cert_file.empty()) {
-      auto cert = ReadFileToString(o.tls_cert_file, 1 << 20);
-      if (!cert.ok()) return cert.status();
-      auto key = ReadFileToString(o.tls_key_file, 1 << 20);
-      if (!key.ok()) return key.status();
-      ssl.pem_cert_chain = *cert;
-      ssl.pem_private_key = *key;
+      ASSIGN_OR_RETURN(auto cert, ReadFileToString(o.tls_cert_file, 1 << 20));
+      ASSIGN_OR_RETURN(auto key, ReadFileToString(o.tls_key_file, 1 << 20));
+      ssl.pem_cert_chain = cert;
+      ssl.pem_private_key = key;
     }
     creds = grpc::SslCredentials(ssl);
   }
@@ -70,12 +68,19 @@ void RemoteClient::Prepare(grpc::ClientContext* ctx) const {
   ctx->set_wait_for_ready(true);  // ride out a replica restarting
 }
 
-absl::StatusOr<v1::FilterResponse> RemoteClient::Filter(const v1::FilterRequest& request) {
+template <typename Request, typename Response>
+absl::StatusOr<Response> RemoteClient::Unary(grpc::Status (v1::InspectionService::Stub::*rpc)(
+                                                 grpc::ClientContext*, const Request&, Response*),
+                                             const Request& request) {
   grpc::ClientContext ctx;
   Prepare(&ctx);
-  v1::FilterResponse resp;
-  if (auto st = FromGrpc(stub_->Filter(&ctx, request, &resp)); !st.ok()) return st;
-  return resp;
+  Response response;
+  RETURN_IF_ERROR(FromGrpc((stub_.get()->*rpc)(&ctx, request, &response)));
+  return response;
+}
+
+absl::StatusOr<v1::FilterResponse> RemoteClient::Filter(const v1::FilterRequest& request) {
+  return Unary(&v1::InspectionService::Stub::Filter, request);
 }
 
 namespace {
@@ -112,23 +117,15 @@ absl::StatusOr<v1::CalibrateResponse> RemoteClient::Calibrate(v1::CalibrateReque
                                                               const TriangleMesh& gauge) {
   return WithMesh<v1::CalibrateRequest, v1::CalibrateResponse>(
       std::move(request), &v1::CalibrateRequest::mutable_gauge, gauge,
-      [this](const v1::CalibrateRequest& r) -> absl::StatusOr<v1::CalibrateResponse> {
-        grpc::ClientContext ctx;
-        Prepare(&ctx);
-        v1::CalibrateResponse resp;
-        if (auto st = FromGrpc(stub_->Calibrate(&ctx, r, &resp)); !st.ok()) return st;
-        return resp;
+      [this](const v1::CalibrateRequest& r) {
+        return Unary(&v1::InspectionService::Stub::Calibrate, r);
       });
 }
 
 absl::StatusOr<v1::RegisterResponse> RemoteClient::Register(v1::RegisterRequest request,
                                                             const TriangleMesh* part) {
-  auto call = [this](const v1::RegisterRequest& r) -> absl::StatusOr<v1::RegisterResponse> {
-    grpc::ClientContext ctx;
-    Prepare(&ctx);
-    v1::RegisterResponse resp;
-    if (auto st = FromGrpc(stub_->Register(&ctx, r, &resp)); !st.ok()) return st;
-    return resp;
+  auto call = [this](const v1::RegisterRequest& r) {
+    return Unary(&v1::InspectionService::Stub::Register, r);
   };
   if (!part) return call(request);
   return WithMesh<v1::RegisterRequest, v1::RegisterResponse>(
@@ -139,12 +136,8 @@ absl::StatusOr<v1::ErrorMapResponse> RemoteClient::ErrorMap(v1::ErrorMapRequest 
                                                             const TriangleMesh& part) {
   return WithMesh<v1::ErrorMapRequest, v1::ErrorMapResponse>(
       std::move(request), &v1::ErrorMapRequest::mutable_part, part,
-      [this](const v1::ErrorMapRequest& r) -> absl::StatusOr<v1::ErrorMapResponse> {
-        grpc::ClientContext ctx;
-        Prepare(&ctx);
-        v1::ErrorMapResponse resp;
-        if (auto st = FromGrpc(stub_->ErrorMap(&ctx, r, &resp)); !st.ok()) return st;
-        return resp;
+      [this](const v1::ErrorMapRequest& r) {
+        return Unary(&v1::InspectionService::Stub::ErrorMap, r);
       });
 }
 
@@ -208,7 +201,7 @@ absl::StatusOr<v1::InspectResult> RemoteClient::InspectOnce(const v1::PartHeader
       have_result = true;
     }
   }
-  if (auto st = FromGrpc(stream->Finish()); !st.ok()) return st;
+  RETURN_IF_ERROR(FromGrpc(stream->Finish()));
   if (!have_result) return absl::InternalError("Inspect stream ended without a result");
   return result;
 }
@@ -222,7 +215,7 @@ absl::StatusOr<std::string> RemoteClient::Health(const std::string& service) {
   grpc::health::v1::HealthCheckRequest req;
   req.set_service(service);
   grpc::health::v1::HealthCheckResponse resp;
-  if (auto st = FromGrpc(health->Check(&ctx, req, &resp)); !st.ok()) return st;
+  RETURN_IF_ERROR(FromGrpc(health->Check(&ctx, req, &resp)));
   return grpc::health::v1::HealthCheckResponse::ServingStatus_Name(resp.status());
 }
 

@@ -68,6 +68,11 @@ class RemoteClient {
  private:
   explicit RemoteClient(const RemoteOptions& options, std::shared_ptr<grpc::Channel> channel);
   void Prepare(grpc::ClientContext* ctx) const;
+  // One unary call of the stub's `rpc` with this client's deadline and token.
+  template <typename Request, typename Response>
+  absl::StatusOr<Response> Unary(grpc::Status (v1::InspectionService::Stub::*rpc)(
+                                     grpc::ClientContext*, const Request&, Response*),
+                                 const Request& request);
   absl::StatusOr<v1::InspectResult> InspectOnce(const v1::PartHeader& header,
                                                 const std::vector<ViewScan>& views,
                                                 const ProgressFn& progress);

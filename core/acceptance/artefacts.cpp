@@ -4,6 +4,7 @@
 #include <set>
 
 #include "absl/strings/str_cat.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
@@ -30,7 +31,7 @@ absl::Status Get(const json& j, const std::string& key, const std::string& where
 absl::Status GetVec(const json& j, const std::string& key, const std::string& where,
                     Eigen::Vector3d* out) {
   std::vector<double> v;
-  if (auto st = Get(j, key, where, &v); !st.ok()) return st;
+  RETURN_IF_ERROR(Get(j, key, where, &v));
   if (v.size() != 3 || !std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
     return absl::InvalidArgumentError(absl::StrCat(where, ".", key, ": three finite numbers"));
   *out = {v[0], v[1], v[2]};
@@ -38,7 +39,7 @@ absl::Status GetVec(const json& j, const std::string& key, const std::string& wh
 }
 
 absl::Status GetView(const json& j, const std::string& where, ArtefactView* v) {
-  if (auto st = Get(j, "view", where, &v->view); !st.ok()) return st;
+  RETURN_IF_ERROR(Get(j, "view", where, &v->view));
   return GetVec(j, "centre_mm", where, &v->centre_mm);
 }
 
@@ -49,25 +50,25 @@ absl::Status ParseMeasurements(const json& j, const std::string& src, Artefacts*
   for (const json& m : s.value("measurements", json::array())) {
     SphereMeasurement sm;
     const std::string where = src + ": sphere.measurements[]";
-    if (auto st = Get(m, "name", where, &sm.name); !st.ok()) return st;
-    if (auto st = GetView(m, where, &sm.at); !st.ok()) return st;
+    RETURN_IF_ERROR(Get(m, "name", where, &sm.name));
+    RETURN_IF_ERROR(GetView(m, where, &sm.at));
     a->spheres.push_back(sm);
   }
   for (const json& m : b.value("positions", json::array())) {
     BallBarPosition bp;
     const std::string where = src + ": ball_bar.positions[]";
-    if (auto st = Get(m, "name", where, &bp.name); !st.ok()) return st;
-    if (auto st = GetView(m.value("a", json::object()), where + ".a", &bp.a); !st.ok()) return st;
-    if (auto st = GetView(m.value("b", json::object()), where + ".b", &bp.b); !st.ok()) return st;
+    RETURN_IF_ERROR(Get(m, "name", where, &bp.name));
+    RETURN_IF_ERROR(GetView(m.value("a", json::object()), where + ".a", &bp.a));
+    RETURN_IF_ERROR(GetView(m.value("b", json::object()), where + ".b", &bp.b));
     a->ball_bar.push_back(bp);
   }
   for (const json& m : p.value("measurements", json::array())) {
     PlateMeasurement pm;
     const std::string where = src + ": plate.measurements[]";
-    if (auto st = Get(m, "name", where, &pm.name); !st.ok()) return st;
-    if (auto st = GetView(m, where, &pm.at); !st.ok()) return st;
-    if (auto st = GetVec(m, "normal", where, &pm.normal); !st.ok()) return st;
-    if (auto st = Get(m, "radius_mm", where, &pm.radius_mm); !st.ok()) return st;
+    RETURN_IF_ERROR(Get(m, "name", where, &pm.name));
+    RETURN_IF_ERROR(GetView(m, where, &pm.at));
+    RETURN_IF_ERROR(GetVec(m, "normal", where, &pm.normal));
+    RETURN_IF_ERROR(Get(m, "radius_mm", where, &pm.radius_mm));
     if (pm.normal.norm() > 0) pm.normal.normalize();
     a->plates.push_back(pm);
   }
@@ -90,7 +91,7 @@ absl::Status ParseScalars(const json& j, const std::string& src, Artefacts* a) {
         {&m, "PS", "mpe_mm", &a->mpe.ps_mm},
         {&m, "SD", "mpe_mm", &a->mpe.sd_mm},
         {&m, "F", "mpe_mm", &a->mpe.f_mm}})
-    if (auto st = Get(*obj, key, absl::StrCat(src, ": ", where), out); !st.ok()) return st;
+    RETURN_IF_ERROR(Get(*obj, key, absl::StrCat(src, ": ", where), out));
   a->search_mm = j.value("search_mm", a->search_mm);
   a->band_mm = j.value("band_mm", a->band_mm);
   a->outlier_share = j.value("outlier_share", a->outlier_share);
@@ -141,12 +142,12 @@ absl::StatusOr<Artefacts> ArtefactsFromJson(const json& j, const std::string& sr
     return absl::InvalidArgumentError(src + ": schema: expected \"surfinspect.artefacts/1\"");
   Artefacts a;
   try {
-    if (auto st = ParseScalars(j, src, &a); !st.ok()) return st;
-    if (auto st = ParseMeasurements(j, src, &a); !st.ok()) return st;
+    RETURN_IF_ERROR(ParseScalars(j, src, &a));
+    RETURN_IF_ERROR(ParseMeasurements(j, src, &a));
   } catch (const json::exception& e) {
     return absl::InvalidArgumentError(absl::StrCat(src, ": ", e.what()));
   }
-  if (auto st = ValidateArtefacts(a, src); !st.ok()) return st;
+  RETURN_IF_ERROR(ValidateArtefacts(a, src));
   return a;
 }
 

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
@@ -38,18 +39,17 @@ absl::Status MeasureBallBar(const Artefacts& a,
   for (const BallBarPosition& bp : a.ball_bar) {
     SpacingResult s;
     s.position = bp;
-    auto cloud_a = scan(bp.name, bp.a.view);
-    if (!cloud_a.ok()) return cloud_a.status();
-    absl::StatusOr<PointCloud> cloud_b = *cloud_a;
+    ASSIGN_OR_RETURN(auto cloud_a, scan(bp.name, bp.a.view));
+    absl::StatusOr<PointCloud> cloud_b = cloud_a;
     if (bp.cross_view()) cloud_b = scan(bp.name, bp.b.view);
     if (!cloud_b.ok()) return cloud_b.status();
     const double d = a.ball_bar_sphere_diameter_mm;
-    auto fa = MeasureSphere(*cloud_a, SearchFor(a, bp.a, d), a.outlier_share, bp.name + ".a");
-    if (!fa.ok()) return fa.status();
-    auto fb = MeasureSphere(*cloud_b, SearchFor(a, bp.b, d), a.outlier_share, bp.name + ".b");
-    if (!fb.ok()) return fb.status();
-    s.a = *std::move(fa);
-    s.b = *std::move(fb);
+    ASSIGN_OR_RETURN(
+        auto fa, MeasureSphere(cloud_a, SearchFor(a, bp.a, d), a.outlier_share, bp.name + ".a"));
+    ASSIGN_OR_RETURN(
+        auto fb, MeasureSphere(*cloud_b, SearchFor(a, bp.b, d), a.outlier_share, bp.name + ".b"));
+    s.a = std::move(fa);
+    s.b = std::move(fb);
     s.spacing =
         ComputeSphereSpacing(s.a, views.at(bp.a.view), s.b, views.at(bp.b.view), !bp.cross_view(),
                              a.ball_bar_length_mm, a.ball_bar_length_u_mm);
@@ -100,33 +100,30 @@ json CrossViewJson(const AcceptanceResult& r) {
 absl::StatusOr<AcceptanceResult> RunAcceptance(
     const Artefacts& a, const std::map<std::string, ViewCalibrationUncertainty>& views,
     const WorldScanFn& scan) {
-  if (auto st = ValidateArtefacts(a, "artefacts"); !st.ok()) return st;
-  if (auto st = CheckViews(a, views); !st.ok()) return st;
+  RETURN_IF_ERROR(ValidateArtefacts(a, "artefacts"));
+  RETURN_IF_ERROR(CheckViews(a, views));
   AcceptanceResult r;
   for (const SphereMeasurement& m : a.spheres) {
-    auto cloud = scan(m.name, m.at.view);
-    if (!cloud.ok()) return cloud.status();
+    ASSIGN_OR_RETURN(auto cloud, scan(m.name, m.at.view));
     auto e =
-        MeasureSphere(*cloud, SearchFor(a, m.at, a.sphere_diameter_mm), a.outlier_share, m.name);
+        MeasureSphere(cloud, SearchFor(a, m.at, a.sphere_diameter_mm), a.outlier_share, m.name);
     if (!e.ok()) return e.status();
     Worst(r.pf, m.name, e->pf_mm, e->u_pf_mm);
     Worst(r.ps, m.name, e->ps_mm, std::hypot(e->u_ps_mm, a.sphere_diameter_u_mm));
     r.spheres.emplace_back(m.name, *std::move(e));
   }
-  if (auto st = MeasureBallBar(a, views, scan, r); !st.ok()) return st;
+  RETURN_IF_ERROR(MeasureBallBar(a, views, scan, r));
   for (const PlateMeasurement& m : a.plates) {
-    auto cloud = scan(m.name, m.at.view);
-    if (!cloud.ok()) return cloud.status();
+    ASSIGN_OR_RETURN(auto cloud, scan(m.name, m.at.view));
     PlaneSearch s;
     s.centre_hint_mm = m.at.centre_mm;
     s.normal_hint = m.normal;
     s.radius_mm = m.radius_mm;
     s.search_mm = a.search_mm;
     s.band_mm = a.band_mm;
-    auto f = MeasureFlatness(*cloud, s, a.outlier_share, m.name);
-    if (!f.ok()) return f.status();
-    Worst(r.f, m.name, f->f_mm, std::hypot(f->u_f_mm, a.plate_flatness_u_mm));
-    r.plates.emplace_back(m.name, *std::move(f));
+    ASSIGN_OR_RETURN(auto f, MeasureFlatness(cloud, s, a.outlier_share, m.name));
+    Worst(r.f, m.name, f.f_mm, std::hypot(f.u_f_mm, a.plate_flatness_u_mm));
+    r.plates.emplace_back(m.name, std::move(f));
   }
   Judge(r.pf, a.mpe.pf_mm);
   Judge(r.ps, a.mpe.ps_mm);

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
@@ -43,11 +44,10 @@ absl::StatusOr<SphereFit> FitSphere(const std::vector<Eigen::Vector3d>& pts) {
   if (pts.size() < kMinPoints)
     return absl::InvalidArgumentError(
         absl::StrCat("sphere fit: ", pts.size(), " points; at least ", kMinPoints, " needed"));
-  auto start = AlgebraicStart(pts);
-  if (!start.ok()) return start.status();
+  ASSIGN_OR_RETURN(auto start, AlgebraicStart(pts));
   SphereFit f;
-  f.centre = start->head<3>();
-  f.radius = (*start)(3);
+  f.centre = start.head<3>();
+  f.radius = (start)(3);
   Eigen::Matrix4d jtj;
   // Gauss-Newton on d_i = |p_i - c| - r with J_i = [-(p_i - c)^T / |p_i - c|, -1]
   // (Forbes §3.5.2, Shakarji §3.6).

@@ -3,6 +3,7 @@
 #include <cstring>
 
 #include "absl/strings/str_cat.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 
@@ -46,7 +47,7 @@ absl::Status EmbreeDevice::TakeError() {
 
 absl::StatusOr<std::unique_ptr<EmbreeTriangleScene>> EmbreeTriangleScene::Build(
     std::shared_ptr<EmbreeDevice> device, const TriangleMesh& mesh, RTCBuildQuality quality) {
-  if (auto st = mesh.Validate(); !st.ok()) return st;
+  RETURN_IF_ERROR(mesh.Validate());
   std::unique_ptr<EmbreeTriangleScene> s(new EmbreeTriangleScene());
   s->device_ = std::move(device);
   RTCDevice dev = s->device_->get();
@@ -69,7 +70,7 @@ absl::StatusOr<std::unique_ptr<EmbreeTriangleScene>> EmbreeTriangleScene::Build(
   rtcAttachGeometryByID(s->scene_, geom, 0);
   rtcReleaseGeometry(geom);
   rtcCommitScene(s->scene_);
-  if (auto e = s->device_->TakeError(); !e.ok()) return e;
+  RETURN_IF_ERROR(s->device_->TakeError());
   return s;
 }
 

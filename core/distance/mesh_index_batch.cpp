@@ -23,6 +23,7 @@
 #include "core/distance/morton_order.h"
 #include "core/types/cancel.h"
 #include "core/types/default_init_vector.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
@@ -44,7 +45,7 @@ union ResultSlot {
 
 absl::Status CheckInputs(const PointCloud& points, const Eigen::Isometry3d& mesh_from_points,
                          const BatchQuerySettings& settings) {
-  if (auto st = points.Validate(); !st.ok()) return st;
+  RETURN_IF_ERROR(points.Validate());
   if (!(settings.max_distance_mm >= 0))
     return absl::InvalidArgumentError(
         absl::StrCat("closest-point query: max_distance_mm must be >= 0 (or inf), got ",
@@ -109,7 +110,7 @@ absl::Status QueryClosestEach(const MeshIndex& index, const PointCloud& points,
                               const BatchQuerySettings& settings, const std::atomic<bool>* cancel,
                               absl::FunctionRef<void(std::size_t, const ClosestPoint&)> sink,
                               BatchQueryTiming* timing) {
-  if (auto st = CheckInputs(points, mesh_from_points, settings); !st.ok()) return st;
+  RETURN_IF_ERROR(CheckInputs(points, mesh_from_points, settings));
   const std::size_t n = points.size();
   if (n == 0) return absl::OkStatus();
   const auto t0 = std::chrono::steady_clock::now();
@@ -182,7 +183,7 @@ absl::StatusOr<std::vector<ClosestPoint>> QueryClosest(const MeshIndex& index,
                                                        const Eigen::Isometry3d& mesh_from_points,
                                                        const BatchQuerySettings& settings,
                                                        const std::atomic<bool>* cancel) {
-  if (auto st = CheckInputs(points, mesh_from_points, settings); !st.ok()) return st;
+  RETURN_IF_ERROR(CheckInputs(points, mesh_from_points, settings));
   std::vector<ClosestPoint> out;
   try {
     out.resize(points.size());

@@ -15,6 +15,7 @@
 #include "core/distance/mesh_index.h"
 #include "core/distance/mesh_order.h"
 #include "core/distance/wide_bvh.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 
@@ -23,14 +24,13 @@ absl::StatusOr<std::unique_ptr<MeshIndex>> MeshIndex::Build(TriangleMesh mesh,
   if (settings.build_threads < 0)
     return absl::InvalidArgumentError(
         absl::StrCat("mesh index: build_threads must be >= 0, got ", settings.build_threads));
-  if (auto st = mesh.Validate(); !st.ok()) return st;
+  RETURN_IF_ERROR(mesh.Validate());
   if (mesh.triangles.size() >= UINT32_MAX || mesh.vertices.size() >= UINT32_MAX)
     return absl::InvalidArgumentError("mesh index: more than 2^32-1 triangles or vertices");
   const auto start = std::chrono::steady_clock::now();
   std::unique_ptr<MeshIndex> index(new MeshIndex());
   index->mesh_ = std::move(mesh);
-  auto device = EmbreeDevice::Create();
-  if (!device.ok()) return device.status();
+  ASSIGN_OR_RETURN(auto device, EmbreeDevice::Create());
   // Embree builds with TBB; an arena bounds the build's threads without a
   // process-global limit (Embree's own "threads=" config sets one).
   tbb::task_arena arena(settings.build_threads > 0 ? settings.build_threads
@@ -39,7 +39,7 @@ absl::StatusOr<std::unique_ptr<MeshIndex>> MeshIndex::Build(TriangleMesh mesh,
   arena.execute([&] {
     try {
       index->ComputeFaceNormals();
-      bvh = index->BuildInOrder((*device)->get(), settings);
+      bvh = index->BuildInOrder((device)->get(), settings);
     } catch (const std::bad_alloc&) {
       bvh = absl::ResourceExhaustedError(
           absl::StrCat("mesh index: out of memory building the index of ",
@@ -47,12 +47,11 @@ absl::StatusOr<std::unique_ptr<MeshIndex>> MeshIndex::Build(TriangleMesh mesh,
     }
   });
   if (!bvh.ok()) {
-    if (auto st = (*device)->TakeError(); !st.ok()) return st;
+    RETURN_IF_ERROR((device)->TakeError());
     return bvh.status();
   }
   index->bvh_ = std::make_unique<WideBvh>(*std::move(bvh));
-  if (settings.hint_certificates)
-    if (auto st = index->BuildCertificates(settings); !st.ok()) return st;
+  if (settings.hint_certificates) RETURN_IF_ERROR(index->BuildCertificates(settings));
   index->info_.triangles = index->mesh_.num_triangles();
   index->info_.bvh_nodes = index->bvh_->stats().nodes;
   index->info_.bvh_depth = index->bvh_->stats().depth;

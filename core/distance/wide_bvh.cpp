@@ -11,6 +11,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/distance/point_triangle.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
@@ -270,7 +271,7 @@ absl::StatusOr<WideBvh> WideBvh::Build(RTCDevice device, const TriangleMesh& mes
   const auto* root = static_cast<const BuildItem*>(rtcBuildBVH(&args));
   if (!root) return absl::InternalError("mesh index: Embree's BVH build failed");
   WideBvhBuilder builder(out, mesh, face_normals, shapes);
-  if (auto st = builder.CopyRoot(root); !st.ok()) return st;
+  RETURN_IF_ERROR(builder.CopyRoot(root));
   builder.FillBlocks();
   out.nodes_.shrink_to_fit();
   out.blocks_.shrink_to_fit();

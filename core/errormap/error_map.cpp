@@ -11,6 +11,7 @@
 #include "absl/strings/str_format.h"
 #include "core/types/cancel.h"
 #include "core/types/percentile.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
@@ -178,7 +179,7 @@ absl::StatusOr<ErrorMapResult> ComputeErrorMap(const MeshIndex& index,
                                                const Eigen::Isometry3d& world_from_part,
                                                const ErrorMapSettings& settings,
                                                const std::atomic<bool>* cancel) {
-  if (auto st = ValidateErrorMapSettings(settings); !st.ok()) return st;
+  RETURN_IF_ERROR(ValidateErrorMapSettings(settings));
   const absl::Status cancelled = absl::CancelledError("error map cancelled");
   if (IsCancelled(cancel)) return cancelled;
   // The cloud itself is checked by the query below (PointCloud::Validate),

@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "absl/status/status.h"
-#include "core/filter/union_find.h"
 #include "core/types/point_cloud.h"
+#include "core/types/union_find.h"
 
 namespace surfinspect::grid {
 

@@ -8,6 +8,7 @@
 #include "core/filter/link_clustering_grid.h"
 #include "core/filter/link_clustering_unorganized.h"
 #include "core/types/cancel.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
@@ -44,7 +45,7 @@ absl::Status ValidateLinkClusteringSettings(const LinkClusteringSettings& s) {
 namespace internal {
 
 absl::Status CheckInput(const PointCloud& cloud, const LinkClusteringSettings& settings) {
-  if (auto st = ValidateLinkClusteringSettings(settings); !st.ok()) return st;
+  RETURN_IF_ERROR(ValidateLinkClusteringSettings(settings));
   if (cloud.empty() || cloud.width == 0 || cloud.height == 0)
     return absl::InvalidArgumentError(absl::StrCat(
         "link clustering: the cloud has no points (grid ", cloud.width, " x ", cloud.height, ")"));
@@ -97,7 +98,7 @@ absl::StatusOr<LinkClusteringResult> ClusterLinks(const PointCloud& cloud,
                                                   const LinkClusteringSettings& settings,
                                                   const std::atomic<bool>* cancel) {
   LinkClusteringResult result;
-  if (auto st = ClusterLinksInto(cloud, settings, result, cancel); !st.ok()) return st;
+  RETURN_IF_ERROR(ClusterLinksInto(cloud, settings, result, cancel));
   return result;
 }
 
@@ -114,7 +115,7 @@ absl::StatusOr<PointCloud> ApplyFilter(const PointCloud& cloud,
 
 absl::Status RemoveOutliers(PointCloud& cloud, const LinkClusteringSettings& settings,
                             LinkClusteringResult& result, const std::atomic<bool>* cancel) {
-  if (auto st = ClusterLinksInto(cloud, settings, result, cancel); !st.ok()) return st;
+  RETURN_IF_ERROR(ClusterLinksInto(cloud, settings, result, cancel));
   if (IsCancelled(cancel)) return absl::CancelledError("link clustering: cancelled");
   SetRemovedToNaN(result, cloud);
   return absl::OkStatus();

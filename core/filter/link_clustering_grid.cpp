@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/filter/grid_bands.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
@@ -126,7 +127,7 @@ void WriteBand(const Band& band, const std::vector<int32_t>& component, uint32_t
 
 absl::Status ClusterLinksOrganized(const PointCloud& cloud, const LinkClusteringSettings& settings,
                                    LinkClusteringResult& result, const std::atomic<bool>* cancel) {
-  if (auto st = internal::CheckInput(cloud, settings); !st.ok()) return st;
+  RETURN_IF_ERROR(internal::CheckInput(cloud, settings));
   const float r2 = LinkDistanceSquared(settings.link_distance_mm);
   const bool eight = settings.connectivity == 8;
   std::vector<Band> bands((cloud.height + kBandRows - 1) / kBandRows);

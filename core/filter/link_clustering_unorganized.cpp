@@ -7,10 +7,11 @@
 
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
-#include "core/filter/union_find.h"
 #include "core/types/cancel.h"
 #include "core/types/default_init_vector.h"
 #include "core/types/radix_sort.h"
+#include "core/types/status_macros.h"
+#include "core/types/union_find.h"
 
 namespace surfinspect {
 namespace {
@@ -219,21 +220,19 @@ absl::Status ClusterLinksUnorganized(const PointCloud& cloud,
                                      const LinkClusteringSettings& settings,
                                      LinkClusteringResult& result,
                                      const std::atomic<bool>* cancel) {
-  if (auto st = internal::CheckInput(cloud, settings); !st.ok()) return st;
+  RETURN_IF_ERROR(internal::CheckInput(cloud, settings));
   const absl::Status cancelled = absl::CancelledError("link clustering: cancelled");
   result.input_points = cloud.size();
   result.organized_path = false;
   result.clusters.clear();
   if (!FillUnlessCancelled(result.labels, cloud.size(), kInvalid, cancel)) return cancelled;
-  auto bounds = BoundValidPoints(cloud, cancel);
-  if (!bounds.ok()) return bounds.status();
-  auto grid = MakeCellGrid(*bounds, settings.link_distance_mm);
-  if (!grid.ok()) return grid.status();
+  ASSIGN_OR_RETURN(auto bounds, BoundValidPoints(cloud, cancel));
+  ASSIGN_OR_RETURN(auto grid, MakeCellGrid(bounds, settings.link_distance_mm));
   SortedCells cells;
   std::vector<uint32_t> order;  // sorted position -> point index
-  if (!SortByCell(cloud, *grid, bounds->count, cells, order, cancel)) return cancelled;
+  if (!SortByCell(cloud, grid, bounds.count, cells, order, cancel)) return cancelled;
   UnionFind forest;
-  if (!LinkCells(cells, *grid, LinkDistanceSquared(settings.link_distance_mm), forest, cancel))
+  if (!LinkCells(cells, grid, LinkDistanceSquared(settings.link_distance_mm), forest, cancel))
     return cancelled;
   if (!NumberComponents(cloud, cells, order, forest, result, cancel)) return cancelled;
   internal::DecideClusters(settings, result);

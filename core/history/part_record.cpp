@@ -1,53 +1,34 @@
 #include "core/history/part_record.h"
 
-#include <cmath>
-#include <nlohmann/json.hpp>
-
 #include "absl/strings/str_cat.h"
+#include "core/pipeline/inspection_report.h"
 
 namespace surfinspect {
-namespace {
-
-double Number(const nlohmann::json& j, const char* key) {
-  const auto it = j.find(key);
-  return it != j.end() && it->is_number() ? it->get<double>() : NAN;
-}
-
-}  // namespace
 
 absl::Status FillFromReportJson(const std::string& text, const std::string& where,
                                 PartRecord* record) {
-  const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
-  if (j.is_discarded() || !j.is_object())
-    return absl::DataLossError(absl::StrCat(where, ": not a JSON object"));
-  if (!j.contains("verdict") || !j["verdict"].is_string())
-    return absl::DataLossError(absl::StrCat(where, ": no verdict"));
-  record->verdict = j["verdict"].get<std::string>();
+  const absl::StatusOr<InspectionReport> report = ParseReport(text);
+  if (!report.ok())
+    return absl::DataLossError(absl::StrCat(where, ": ", report.status().message()));
+  if (report->verdict.empty()) return absl::DataLossError(absl::StrCat(where, ": no verdict"));
+  record->verdict = report->verdict;
   record->characteristics.clear();
-  const nlohmann::json& list =
-      j.contains("characteristics") ? j["characteristics"] : nlohmann::json::array();
-  if (!list.is_array()) return absl::DataLossError(absl::StrCat(where, ": characteristics"));
-  for (const nlohmann::json& c : list) {
-    if (!c.is_object() || !c.contains("name") || !c["name"].is_string())
-      return absl::DataLossError(absl::StrCat(where, ": a characteristic without a name"));
+  for (const ReportCharacteristic& c : report->characteristics) {
     CharacteristicRecord r;
-    r.name = c["name"].get<std::string>();
-    r.type = c.value("type", std::string());
-    r.verdict = c.value("verdict", std::string());
-    r.mean_mm = Number(c, "mean_mm");
-    r.min_mm = Number(c, "min_mm");
-    r.max_mm = Number(c, "max_mm");
-    r.stddev_mm = Number(c, "stddev_mm");
-    r.value_mm = r.type == "point" ? Number(c, "value_mm") : r.mean_mm;
-    if (c.contains("tolerance_mm") && c["tolerance_mm"].is_object()) {
-      r.lower_mm = Number(c["tolerance_mm"], "lower");
-      r.upper_mm = Number(c["tolerance_mm"], "upper");
-    }
-    r.points =
-        c.contains("points") && c["points"].is_number_integer() ? c["points"].get<int64_t>() : 0;
+    r.name = c.name;
+    r.type = c.type;
+    r.verdict = c.verdict;
+    r.mean_mm = c.mean_mm;
+    r.min_mm = c.min_mm;
+    r.max_mm = c.max_mm;
+    r.stddev_mm = c.stddev_mm;
+    r.value_mm = c.is_point() ? c.value_mm : c.mean_mm;
+    r.lower_mm = c.tolerance.lower_mm;
+    r.upper_mm = c.tolerance.upper_mm;
+    r.points = static_cast<int64_t>(c.points);
     record->characteristics.push_back(std::move(r));
   }
-  record->defects_json = j.contains("defects") ? j["defects"].dump() : "[]";
+  record->defects_json = EncodeDefects(report->defects).dump();
   return absl::OkStatus();
 }
 

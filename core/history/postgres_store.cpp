@@ -10,6 +10,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "core/history/store_schema.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
@@ -86,10 +87,9 @@ absl::Status PostgresStore::Migrate() {
   try {
     pqxx::work tx(connection_);
     tx.exec_params("SELECT pg_advisory_xact_lock($1)", kMigrationLock);
-    auto version = VersionIn(tx);
-    if (!version.ok()) return version.status();
-    if (auto st = CheckSchemaVersion(name_, *version); !st.ok()) return st;
-    for (int v = *version + 1; v <= LatestSchemaVersion(); ++v) {
+    ASSIGN_OR_RETURN(auto version, VersionIn(tx));
+    RETURN_IF_ERROR(CheckSchemaVersion(name_, version));
+    for (int v = version + 1; v <= LatestSchemaVersion(); ++v) {
       for (const std::string& sql : MigrationStatements(v, {"BYTEA", "DOUBLE PRECISION"}))
         tx.exec(sql);
       if (v == 1)
@@ -199,9 +199,7 @@ absl::StatusOr<std::vector<PartRecord>> PostgresStore::Load(const PartSelection&
         if (it == by_key.end()) continue;
         it->second->num_triangles = row[2].as<uint32_t>();
         const pqxx::binarystring blob(row[3]);
-        auto tri = UnpackTriangles(blob.str());
-        if (!tri.ok()) return tri.status();
-        it->second->triangles = *std::move(tri);
+        ASSIGN_OR_RETURN(it->second->triangles, UnpackTriangles(blob.str()));
       }
     }
     return parts;
@@ -221,7 +219,7 @@ absl::StatusOr<std::unique_ptr<ResultsStore>> OpenPostgresStore(const std::strin
     return absl::UnavailableError(
         absl::StrCat(name, ": cannot connect to the results database: ", e.what()));
   }
-  if (auto st = store->Migrate(); !st.ok()) return st;
+  RETURN_IF_ERROR(store->Migrate());
   return std::unique_ptr<ResultsStore>(std::move(store));
 }
 

@@ -9,6 +9,7 @@
 #include "absl/functional/function_ref.h"
 #include "absl/strings/str_cat.h"
 #include "core/history/store_schema.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
@@ -89,30 +90,27 @@ void BindFilter(sqlite3_stmt* s, const PartSelection& sel) {
 }
 
 absl::StatusOr<int> SqliteStore::SchemaVersion() {
-  auto tables = Prepare("SELECT name FROM sqlite_master WHERE type = 'table'");
-  if (!tables.ok()) return tables.status();
+  ASSIGN_OR_RETURN(auto tables, Prepare("SELECT name FROM sqlite_master WHERE type = 'table'"));
   std::set<std::string> names;
   int rc;
-  while ((rc = sqlite3_step(tables->get())) == SQLITE_ROW)
-    names.insert(ColumnText(tables->get(), 0));
+  while ((rc = sqlite3_step(tables.get())) == SQLITE_ROW) names.insert(ColumnText(tables.get(), 0));
   if (rc != SQLITE_DONE) return Error("cannot list tables");
   if (names.empty()) return 0;
   if (!names.count("schema_version"))
     return absl::FailedPreconditionError(
         absl::StrCat(path_, ": a foreign database (it has tables but no schema_version of ",
                      kStoreApplication, ")"));
-  auto v = Prepare("SELECT application, version FROM schema_version");
-  if (!v.ok()) return v.status();
-  if (sqlite3_step(v->get()) != SQLITE_ROW || ColumnText(v->get(), 0) != kStoreApplication)
+  ASSIGN_OR_RETURN(auto v, Prepare("SELECT application, version FROM schema_version"));
+  if (sqlite3_step(v.get()) != SQLITE_ROW || ColumnText(v.get(), 0) != kStoreApplication)
     return absl::FailedPreconditionError(absl::StrCat(
         path_, ": a foreign database (schema_version is not ", kStoreApplication, ")"));
-  return sqlite3_column_int(v->get(), 1);
+  return sqlite3_column_int(v.get(), 1);
 }
 
 absl::Status SqliteStore::Migrate() {
-  if (auto st = Exec("PRAGMA journal_mode = WAL"); !st.ok()) return st;
-  if (auto st = Exec("PRAGMA foreign_keys = ON; PRAGMA synchronous = NORMAL"); !st.ok()) return st;
-  if (auto st = Exec("BEGIN IMMEDIATE"); !st.ok()) return st;
+  RETURN_IF_ERROR(Exec("PRAGMA journal_mode = WAL"));
+  RETURN_IF_ERROR(Exec("PRAGMA foreign_keys = ON; PRAGMA synchronous = NORMAL"));
+  RETURN_IF_ERROR(Exec("BEGIN IMMEDIATE"));
   auto version = SchemaVersion();
   absl::Status st = version.ok() ? CheckSchemaVersion(path_, *version) : version.status();
   for (int v = version.ok() ? *version + 1 : 1; st.ok() && v <= LatestSchemaVersion(); ++v) {
@@ -131,23 +129,23 @@ absl::Status SqliteStore::Migrate() {
 }
 
 absl::StatusOr<bool> SqliteStore::Contains(const std::string& cell, const std::string& part_id) {
-  auto s = Prepare("SELECT 1 FROM parts WHERE cell = ?1 AND part_id = ?2");
-  if (!s.ok()) return s.status();
-  BindText(s->get(), 1, cell);
-  BindText(s->get(), 2, part_id);
-  const int rc = sqlite3_step(s->get());
+  ASSIGN_OR_RETURN(auto s, Prepare("SELECT 1 FROM parts WHERE cell = ?1 AND part_id = ?2"));
+  BindText(s.get(), 1, cell);
+  BindText(s.get(), 2, part_id);
+  const int rc = sqlite3_step(s.get());
   if (rc != SQLITE_ROW && rc != SQLITE_DONE) return Error("cannot look up " + part_id);
   return rc == SQLITE_ROW;
 }
 
 absl::Status SqliteStore::InsertCharacteristics(const PartRecord& part) {
-  auto s = Prepare(
-      "INSERT INTO characteristics VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, "
-      "?13, ?14)");
-  if (!s.ok()) return s.status();
+  ASSIGN_OR_RETURN(
+      auto s,
+      Prepare(
+          "INSERT INTO characteristics VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, "
+          "?13, ?14)"));
   for (std::size_t i = 0; i < part.characteristics.size(); ++i) {
     const CharacteristicRecord& c = part.characteristics[i];
-    sqlite3_stmt* st = s->get();
+    sqlite3_stmt* st = s.get();
     sqlite3_reset(st);
     BindText(st, 1, part.cell);
     BindText(st, 2, part.part_id);
@@ -165,19 +163,18 @@ absl::Status SqliteStore::InsertCharacteristics(const PartRecord& part) {
 }
 
 absl::Status SqliteStore::InsertTriangles(const PartRecord& part) {
-  auto s = Prepare("INSERT INTO triangle_summaries VALUES (?1, ?2, ?3, ?4)");
-  if (!s.ok()) return s.status();
+  ASSIGN_OR_RETURN(auto s, Prepare("INSERT INTO triangle_summaries VALUES (?1, ?2, ?3, ?4)"));
   const std::string packed = PackTriangles(part.triangles);
-  BindText(s->get(), 1, part.cell);
-  BindText(s->get(), 2, part.part_id);
-  sqlite3_bind_int64(s->get(), 3, part.num_triangles);
-  sqlite3_bind_blob(s->get(), 4, packed.data(), static_cast<int>(packed.size()), SQLITE_TRANSIENT);
-  if (sqlite3_step(s->get()) != SQLITE_DONE) return Error("cannot write the triangle summary");
+  BindText(s.get(), 1, part.cell);
+  BindText(s.get(), 2, part.part_id);
+  sqlite3_bind_int64(s.get(), 3, part.num_triangles);
+  sqlite3_bind_blob(s.get(), 4, packed.data(), static_cast<int>(packed.size()), SQLITE_TRANSIENT);
+  if (sqlite3_step(s.get()) != SQLITE_DONE) return Error("cannot write the triangle summary");
   return absl::OkStatus();
 }
 
 absl::StatusOr<bool> SqliteStore::Record(const PartRecord& p) {
-  if (auto st = Exec("BEGIN IMMEDIATE"); !st.ok()) return st;
+  RETURN_IF_ERROR(Exec("BEGIN IMMEDIATE"));
   auto s = Prepare(
       "INSERT INTO parts VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10) "
       "ON CONFLICT (cell, part_id) DO NOTHING");
@@ -199,7 +196,7 @@ absl::StatusOr<bool> SqliteStore::Record(const PartRecord& p) {
     Exec("ROLLBACK").IgnoreError();  // the write's own error is the one to report
     return st;
   }
-  if (auto c = Exec("COMMIT"); !c.ok()) return c;
+  RETURN_IF_ERROR(Exec("COMMIT"));
   return written;
 }
 
@@ -208,15 +205,14 @@ absl::Status SqliteStore::ForEachPartRow(
     const char* what, absl::FunctionRef<absl::Status(sqlite3_stmt*, PartRecord&)> row) {
   std::map<std::string, PartRecord*> by_key;
   for (PartRecord& p : parts) by_key[StoreKey(p.cell, p.part_id)] = &p;
-  auto s = Prepare(sql);
-  if (!s.ok()) return s.status();
-  BindFilter(s->get(), sel);
+  ASSIGN_OR_RETURN(auto s, Prepare(sql));
+  BindFilter(s.get(), sel);
   int rc;
-  while ((rc = sqlite3_step(s->get())) == SQLITE_ROW) {
-    sqlite3_stmt* r = s->get();
+  while ((rc = sqlite3_step(s.get())) == SQLITE_ROW) {
+    sqlite3_stmt* r = s.get();
     auto it = by_key.find(StoreKey(ColumnText(r, 0), ColumnText(r, 1)));
     if (it == by_key.end()) continue;
-    if (auto st = row(r, *it->second); !st.ok()) return st;
+    RETURN_IF_ERROR(row(r, *it->second));
   }
   return rc == SQLITE_DONE ? absl::OkStatus() : Error(absl::StrCat("cannot read ", what));
 }
@@ -255,7 +251,7 @@ absl::Status SqliteStore::LoadTriangles(std::vector<PartRecord>& parts, const Pa
 
 absl::StatusOr<std::vector<PartRecord>> SqliteStore::Load(const PartSelection& sel) {
   // One read transaction: a snapshot, whatever a writer does meanwhile.
-  if (auto st = Exec("BEGIN"); !st.ok()) return st;
+  RETURN_IF_ERROR(Exec("BEGIN"));
   auto s = Prepare(
       "SELECT p.cell, p.part_id, p.inspected_utc, p.software_version, p.plan_hash, p.verdict, "
       "p.defects_json, p.calibration_json, p.files_json FROM parts p" +
@@ -293,7 +289,7 @@ absl::StatusOr<std::unique_ptr<ResultsStore>> OpenSqliteStore(const std::string&
                                             raw ? sqlite3_errmsg(raw) : sqlite3_errstr(rc)));
   sqlite3_busy_timeout(db.get(), 10000);
   auto store = std::make_unique<SqliteStore>(std::move(db), path);
-  if (auto st = store->Migrate(); !st.ok()) return st;
+  RETURN_IF_ERROR(store->Migrate());
   return std::unique_ptr<ResultsStore>(std::move(store));
 }
 

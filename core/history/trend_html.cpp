@@ -11,6 +11,7 @@
 #include "core/report/html_payload.h"
 #include "core/report/viewer_assets.h"
 #include "core/report/viewer_page.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
@@ -163,15 +164,14 @@ absl::StatusOr<std::string> TrendViewerHtml(const Trend& trend, const std::strin
                                             const TriangleMesh& mesh) {
   std::string blob;
   nlohmann::json palette;
-  auto map = TrendMapData(trend.map, mesh.num_triangles(), blob, palette);
-  if (!map.ok()) return map.status();
+  ASSIGN_OR_RETURN(auto map, TrendMapData(trend.map, mesh.num_triangles(), blob, palette));
   std::vector<uint32_t> triangles;
   triangles.reserve(3 * mesh.num_triangles());
   for (const Triangle& t : mesh.triangles) triangles.insert(triangles.end(), t.begin(), t.end());
   nlohmann::json data = {{"kind", "trend_map"},
                          {"palette", std::move(palette)},
                          {"mesh", MeshJson(QuantisePositions(mesh.vertices), triangles, blob)},
-                         {"trend", std::move(*map)},
+                         {"trend", std::move(map)},
                          {"three", std::string(GetViewerAssets().three_version)}};
   std::string side = absl::StrCat("<aside id=\"side\">\n", Intro(trend));
   for (const CharacteristicTrend& c : trend.characteristics) side += Section(c);

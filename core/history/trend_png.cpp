@@ -6,8 +6,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "core/errormap/error_map_output.h"
-#include "core/errormap/error_map_png.h"
+#include "core/errormap/deviation_color.h"
+#include "core/report/error_map_png.h"
 
 namespace surfinspect {
 namespace {

@@ -17,6 +17,7 @@
 #include "core/io/ply_format.h"
 #include "core/io/ply_mesh.h"
 #include "core/io/text_parse.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
@@ -69,12 +70,11 @@ absl::StatusOr<TriangleMesh> ReadByFormat(const std::string& path, const std::st
                                           const MeshReadLimits& limits) {
   if (ext != "stl" && ext != "obj" && ext != "ply" && ext != "off")
     return Bad(path, "unknown mesh format (expected .stl, .obj, .ply or .off)");
-  auto bytes = ReadWholeFile(path, limits.max_file_bytes);
-  if (!bytes.ok()) return bytes.status();
-  if (ext == "ply") return ParsePlyMesh(*bytes, limits, path);
-  if (ext == "off") return ParseOff(*bytes, limits, path);
+  ASSIGN_OR_RETURN(auto bytes, ReadWholeFile(path, limits.max_file_bytes));
+  if (ext == "ply") return ParsePlyMesh(bytes, limits, path);
+  if (ext == "off") return ParseOff(bytes, limits, path);
   const absl::Status check =
-      ext == "stl" ? CheckStl(*bytes, limits, path) : CheckObj(*bytes, limits, path);
+      ext == "stl" ? CheckStl(bytes, limits, path) : CheckObj(bytes, limits, path);
   if (!check.ok()) return check;
   return ImportWithAssimp(path);
 }
@@ -82,21 +82,19 @@ absl::StatusOr<TriangleMesh> ReadByFormat(const std::string& path, const std::st
 }  // namespace
 
 absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path, const MeshReadLimits& limits) {
-  auto mesh = ReadByFormat(path, Extension(path), limits);
-  if (!mesh.ok()) return mesh.status();
-  if (mesh->num_triangles() > limits.max_triangles)
+  ASSIGN_OR_RETURN(auto mesh, ReadByFormat(path, Extension(path), limits));
+  if (mesh.num_triangles() > limits.max_triangles)
     return absl::ResourceExhaustedError(absl::StrCat(
-        path, ": ", mesh->num_triangles(), " faces exceed the limit of ", limits.max_triangles));
-  if (auto st = mesh->Validate(); !st.ok()) return Bad(path, st.message());
+        path, ": ", mesh.num_triangles(), " faces exceed the limit of ", limits.max_triangles));
+  if (auto st = mesh.Validate(); !st.ok()) return Bad(path, st.message());
   return mesh;
 }
 
 absl::StatusOr<MeshGroups> ReadMeshGroups(const std::string& path, const TriangleMesh& mesh,
                                           const MeshReadLimits& limits) {
   if (Extension(path) != "obj") return MeshGroups{};
-  auto bytes = ReadWholeFile(path, limits.max_file_bytes);
-  if (!bytes.ok()) return bytes.status();
-  return ObjGroups(*bytes, mesh, path);
+  ASSIGN_OR_RETURN(auto bytes, ReadWholeFile(path, limits.max_file_bytes));
+  return ObjGroups(bytes, mesh, path);
 }
 
 bool PlyDeclaresFaces(const std::string& path) {

@@ -11,6 +11,7 @@
 #include "core/io/pcd_format.h"
 #include "core/io/ply_cloud.h"
 #include "core/io/text_parse.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
@@ -30,14 +31,13 @@ absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path, const CloudRe
     return Bad(path, "unknown cloud format (expected .pcd or .ply)");
   if (ext == "ply")
     if (auto direct = ReadPackedXyzPly(path, limits)) return *std::move(direct);
-  auto bytes = ReadWholeFile(path, std::numeric_limits<uint64_t>::max());
-  if (!bytes.ok()) return bytes.status();
-  return ext == "pcd" ? ParsePcd(*bytes, limits, path) : ParsePlyCloud(*bytes, limits, path);
+  ASSIGN_OR_RETURN(auto bytes, ReadWholeFile(path, std::numeric_limits<uint64_t>::max()));
+  return ext == "pcd" ? ParsePcd(bytes, limits, path) : ParsePlyCloud(bytes, limits, path);
 }
 
 absl::Status WritePointCloud(const std::string& path, const PointCloud& cloud,
                              PcdEncoding pcd_encoding, bool ply_binary) {
-  if (auto st = cloud.Validate(); !st.ok()) return st;
+  RETURN_IF_ERROR(cloud.Validate());
   const std::string ext = Extension(path);
   if (ext != "pcd" && ext != "ply")
     return Bad(path, "unknown cloud format (expected .pcd or .ply)");

@@ -4,6 +4,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/io/atomic_file.h"
+#include "core/types/status_macros.h"
 #include "core/types/transform.h"
 
 namespace surfinspect {
@@ -37,9 +38,8 @@ absl::StatusOr<Eigen::Isometry3d> TransformFromJsonValue(const nlohmann::json& j
 }
 
 absl::StatusOr<Eigen::Isometry3d> ReadTransformJson(const std::string& path) {
-  auto text = ReadFileToString(path, 1 << 20);
-  if (!text.ok()) return text.status();
-  return ParseTransformJson(*text, path);
+  ASSIGN_OR_RETURN(auto text, ReadFileToString(path, 1 << 20));
+  return ParseTransformJson(text, path);
 }
 
 nlohmann::json TransformToJsonValue(const Eigen::Isometry3d& t) {

@@ -7,6 +7,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/io/obj_lines.h"
 #include "core/io/text_parse.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
@@ -100,7 +101,7 @@ absl::Status CheckAsciiStl(std::string_view bytes, const MeshReadLimits& limits,
         return Refuse(
             name, absl::StrCat("ASCII STL line ", w.line(),
                                ": expected 'facet' or 'endsolid', found '", Excerpt(word), "'"));
-      if (auto st = Facet(&w, facets, name); !st.ok()) return st;
+      RETURN_IF_ERROR(Facet(&w, facets, name));
       if (++facets > limits.max_triangles) return TooMany(name, facets, limits);
     }
   }
@@ -215,7 +216,7 @@ absl::Status CheckObj(std::string_view bytes, const MeshReadLimits& limits, std:
   uint64_t faces = 0;
   absl::Status st = ForEachObjLine(
       bytes, [&](const std::vector<std::string_view>& tok, std::size_t line) -> absl::Status {
-        if (auto bad = CheckObjLine(tok, total, &so_far, line, name); !bad.ok()) return bad;
+        RETURN_IF_ERROR(CheckObjLine(tok, total, &so_far, line, name));
         if (tok[0] == "f" && ++faces > limits.max_triangles) return TooMany(name, faces, limits);
         return absl::OkStatus();
       });

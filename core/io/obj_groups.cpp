@@ -8,6 +8,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/io/obj_lines.h"
 #include "core/io/text_parse.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
@@ -97,16 +98,15 @@ bool CornersOf(const TriangleMesh& mesh, std::size_t t, const ObjFaces& file, co
 
 absl::StatusOr<MeshGroups> ObjGroups(std::string_view bytes, const TriangleMesh& imported,
                                      std::string_view name) {
-  auto file = ReadFaces(bytes, name);
-  if (!file.ok()) return file.status();
+  ASSIGN_OR_RETURN(auto file, ReadFaces(bytes, name));
   MeshGroups groups;
-  if (file->groups.names.empty()) return groups;
-  groups.names = file->groups.names;
+  if (file.groups.names.empty()) return groups;
+  groups.names = file.groups.names;
   groups.triangle_group.reserve(imported.num_triangles());
   std::size_t t = 0;
-  for (const ObjFace& f : file->faces) {
+  for (const ObjFace& f : file.faces) {
     for (std::size_t k = 0; k + 2 < f.corners.size(); ++k, ++t) {
-      if (t >= imported.num_triangles() || !CornersOf(imported, t, *file, f))
+      if (t >= imported.num_triangles() || !CornersOf(imported, t, file, f))
         return absl::FailedPreconditionError(absl::StrCat(
             ToAbsl(name), ": OBJ groups cannot be mapped: the imported triangle ", t,
             " is not part of the face on line ", f.line,

@@ -7,6 +7,7 @@
 
 #include "absl/status/status.h"
 #include "core/io/text_parse.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 
@@ -20,7 +21,7 @@ absl::Status ForEachObjLine(std::string_view bytes, Visit&& visit) {
   while (lines.Next(&line)) {
     SplitWhitespace(line.substr(0, line.find('#')), &tok);
     if (tok.empty()) continue;
-    if (absl::Status st = visit(tok, lines.line_number()); !st.ok()) return st;
+    RETURN_IF_ERROR(visit(tok, lines.line_number()));
   }
   return absl::OkStatus();
 }

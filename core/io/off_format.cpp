@@ -5,6 +5,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/io/polygon_mesh.h"
 #include "core/io/text_parse.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
@@ -128,14 +129,11 @@ absl::Status ReadFaces(LineScanner* lines, uint64_t n, uint64_t vertices, std::s
 absl::StatusOr<TriangleMesh> ParseOff(std::string_view bytes, const MeshReadLimits& limits,
                                       std::string_view name) {
   LineScanner lines(bytes);
-  auto counts = ParseCounts(&lines, name);
-  if (!counts.ok()) return counts.status();
-  if (auto st = CheckCounts(*counts, bytes.size() - lines.pos(), limits, name); !st.ok()) return st;
+  ASSIGN_OR_RETURN(auto counts, ParseCounts(&lines, name));
+  RETURN_IF_ERROR(CheckCounts(counts, bytes.size() - lines.pos(), limits, name));
   IndexedPolygons polygons;
-  if (auto st = ReadVertices(&lines, counts->vertices, name, &polygons.vertices); !st.ok())
-    return st;
-  if (auto st = ReadFaces(&lines, counts->faces, counts->vertices, name, &polygons); !st.ok())
-    return st;
+  RETURN_IF_ERROR(ReadVertices(&lines, counts.vertices, name, &polygons.vertices));
+  RETURN_IF_ERROR(ReadFaces(&lines, counts.faces, counts.vertices, name, &polygons));
   return TriangulateAndMerge(polygons, name);
 }
 

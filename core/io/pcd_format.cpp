@@ -6,6 +6,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/io/pcd_data.h"
 #include "core/io/text_parse.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
@@ -158,22 +159,21 @@ absl::StatusOr<PcdHeader> ParsePcdHeader(std::string_view bytes, const CloudRead
                                          std::string_view name) {
   Entries e;
   PcdHeader h;
-  if (auto st = ReadEntries(bytes, name, &e, &h.data_offset); !st.ok()) return st;
+  RETURN_IF_ERROR(ReadEntries(bytes, name, &e, &h.data_offset));
   for (const char* key : {"FIELDS", "SIZE", "TYPE", "WIDTH", "HEIGHT", "POINTS", "DATA"})
     if (!e.count(key)) return BadFile(name, absl::StrCat("PCD header lacks ", key));
-  if (auto st = CheckSimpleEntries(e, name); !st.ok()) return st;
-  if (auto st = BuildFields(e, name, &h); !st.ok()) return st;
-  if (auto st = CheckXyz(h, name); !st.ok()) return st;
-  if (auto st = ParseDims(e, limits, name, &h); !st.ok()) return st;
-  if (auto st = ParseData(e, name, &h); !st.ok()) return st;
+  RETURN_IF_ERROR(CheckSimpleEntries(e, name));
+  RETURN_IF_ERROR(BuildFields(e, name, &h));
+  RETURN_IF_ERROR(CheckXyz(h, name));
+  RETURN_IF_ERROR(ParseDims(e, limits, name, &h));
+  RETURN_IF_ERROR(ParseData(e, name, &h));
   return h;
 }
 
 absl::StatusOr<PointCloud> ParsePcd(std::string_view bytes, const CloudReadLimits& limits,
                                     std::string_view name) {
-  auto h = ParsePcdHeader(bytes, limits, name);
-  if (!h.ok()) return h.status();
-  auto cloud = DecodePcdData(bytes, *h, name);
+  ASSIGN_OR_RETURN(auto h, ParsePcdHeader(bytes, limits, name));
+  auto cloud = DecodePcdData(bytes, h, name);
   if (!cloud.ok()) return cloud;
   if (auto st = cloud->Validate(); !st.ok()) return BadFile(name, st.message());
   return cloud;

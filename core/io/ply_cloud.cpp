@@ -12,6 +12,7 @@
 #include "core/io/ply_format.h"
 #include "core/io/ply_rows.h"
 #include "core/io/text_parse.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
@@ -88,7 +89,7 @@ absl::Status ReadVertices(PlyRowReader* reader, const PlyHeader& h, const PlyEle
   pts->reserve(std::min<uint64_t>(v.count, reader->RemainingBytes() / 2 + 1));
   PlyRow row;
   for (uint64_t i = 0; i < v.count; ++i) {
-    if (auto st = reader->Next(v, i, &row); !st.ok()) return st;
+    RETURN_IF_ERROR(reader->Next(v, i, &row));
     Eigen::Vector3f p;
     for (int a = 0; a < 3; ++a) {
       const PlyValue& val = row.values[row.first[l.prop[a]]];
@@ -113,7 +114,7 @@ absl::Status ReadRangeGrid(PlyRowReader* reader, const PlyHeader& h, const PlyEl
   cells->reserve(std::min<uint64_t>(g.count, reader->RemainingBytes() + 1));
   PlyRow row;
   for (uint64_t r = 0; r < g.count; ++r) {
-    if (auto st = reader->Next(g, r, &row); !st.ok()) return st;
+    RETURN_IF_ERROR(reader->Next(g, r, &row));
     int64_t idx = -1;
     if (row.first[prop + 1] > row.first[prop] &&
         (!PlyIntValue(h.format, g.properties[prop].type, row.values[row.first[prop]], &idx) ||
@@ -145,22 +146,20 @@ absl::Status CheckGrid(const PlyHeader& h, uint64_t vertices, std::string_view n
 
 absl::StatusOr<PointCloud> ParsePlyCloud(std::string_view bytes, const CloudReadLimits& limits,
                                          std::string_view name) {
-  auto h = ParsePlyHeader(bytes, limits.max_points, name);
-  if (!h.ok()) return h.status();
-  const int vi = h->FindElement("vertex");
-  if (vi < 0 || h->elements[vi].count == 0) return BadFile(name, "PLY has no vertices");
-  const PlyElement& vertex = h->elements[vi];
-  auto layout = FindXyz(vertex, name);
-  if (!layout.ok()) return layout.status();
-  if (auto st = CheckBinarySize(bytes, *h, name); !st.ok()) return st;
-  if (auto st = CheckGrid(*h, vertex.count, name); !st.ok()) return st;
-  PlyRowReader reader(bytes, *h, name);
+  ASSIGN_OR_RETURN(auto h, ParsePlyHeader(bytes, limits.max_points, name));
+  const int vi = h.FindElement("vertex");
+  if (vi < 0 || h.elements[vi].count == 0) return BadFile(name, "PLY has no vertices");
+  const PlyElement& vertex = h.elements[vi];
+  ASSIGN_OR_RETURN(auto layout, FindXyz(vertex, name));
+  RETURN_IF_ERROR(CheckBinarySize(bytes, h, name));
+  RETURN_IF_ERROR(CheckGrid(h, vertex.count, name));
+  PlyRowReader reader(bytes, h, name);
   std::vector<Eigen::Vector3f> pts;
   std::vector<int64_t> cells;
-  for (const PlyElement& e : h->elements) {
-    absl::Status st = &e == &vertex ? ReadVertices(&reader, *h, e, *layout, name, &pts)
+  for (const PlyElement& e : h.elements) {
+    absl::Status st = &e == &vertex ? ReadVertices(&reader, h, e, layout, name, &pts)
                       : e.name == "range_grid"
-                          ? ReadRangeGrid(&reader, *h, e, vertex.count, name, &cells)
+                          ? ReadRangeGrid(&reader, h, e, vertex.count, name, &cells)
                           : reader.Skip(e);
     if (!st.ok()) return st;
   }

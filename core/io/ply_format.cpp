@@ -2,6 +2,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/io/text_parse.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
@@ -159,7 +160,7 @@ absl::StatusOr<PlyHeader> ParsePlyHeader(std::string_view bytes, uint64_t max_ro
       h.data_offset = lines.pos();
       return h;
     }
-    if (auto st = ParseHeaderLine(line, max_rows, name, &format_seen, &h); !st.ok()) return st;
+    RETURN_IF_ERROR(ParseHeaderLine(line, max_rows, name, &format_seen, &h));
   }
   return BadFile(name, "truncated header: no 'end_header' line");
 }

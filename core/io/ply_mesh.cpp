@@ -8,6 +8,7 @@
 #include "core/io/ply_rows.h"
 #include "core/io/polygon_mesh.h"
 #include "core/io/text_parse.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
@@ -74,7 +75,7 @@ absl::Status ReadVertices(PlyRowReader* reader, const PlyHeader& h, const PlyEle
   out->reserve(std::min<uint64_t>(e.count, reader->RemainingBytes() / 2 + 1));
   PlyRow row;
   for (uint64_t i = 0; i < e.count; ++i) {
-    if (auto st = reader->Next(e, i, &row); !st.ok()) return st;
+    RETURN_IF_ERROR(reader->Next(e, i, &row));
     Eigen::Vector3f p;
     for (int a = 0; a < 3; ++a)
       if (!Coordinate(h.format, e.properties[prop[a]].type, row.values[row.first[prop[a]]], &p[a]))
@@ -98,7 +99,7 @@ absl::Status ReadFaces(PlyRowReader* reader, const PlyHeader& h, const PlyElemen
   TakeIndexFaces(reader, h, e, vertices, out, &fast);
   PlyRow row;
   for (uint64_t f = fast; f < e.count; ++f) {
-    if (auto st = reader->Next(e, f, &row); !st.ok()) return st;
+    RETURN_IF_ERROR(reader->Next(e, f, &row));
     const uint32_t n = row.first[prop + 1] - row.first[prop];
     if (n < 3)
       return BadFile(name, absl::StrCat("cannot import: face ", f, " has ", n,
@@ -125,28 +126,27 @@ absl::StatusOr<TriangleMesh> ParsePlyMesh(std::string_view bytes, const MeshRead
                                           std::string_view name) {
   uint64_t max_rows = 0;
   if (!CheckedMul(limits.max_triangles, 3, &max_rows)) max_rows = UINT64_MAX;
-  auto h = ParsePlyHeader(bytes, max_rows, name);
-  if (!h.ok()) return h.status();
-  const int vi = h->FindElement("vertex");
-  const int fi = h->FindElement("face");
-  if (vi < 0 || h->elements[vi].count == 0)
+  ASSIGN_OR_RETURN(auto h, ParsePlyHeader(bytes, max_rows, name));
+  const int vi = h.FindElement("vertex");
+  const int fi = h.FindElement("face");
+  if (vi < 0 || h.elements[vi].count == 0)
     return BadFile(name, "cannot import: PLY has no vertices");
-  if (fi < 0 || h->elements[fi].count == 0) return BadFile(name, "cannot import: PLY has no faces");
-  if (h->FindElement("tristrips") >= 0)
+  if (fi < 0 || h.elements[fi].count == 0) return BadFile(name, "cannot import: PLY has no faces");
+  if (h.FindElement("tristrips") >= 0)
     return BadFile(name, "cannot import: PLY triangle strips (tristrips) are not read");
-  if (h->elements[fi].count > limits.max_triangles)
-    return absl::ResourceExhaustedError(absl::StrCat(ToAbsl(name), ": ", h->elements[fi].count,
+  if (h.elements[fi].count > limits.max_triangles)
+    return absl::ResourceExhaustedError(absl::StrCat(ToAbsl(name), ": ", h.elements[fi].count,
                                                      " faces exceed the limit of ",
                                                      limits.max_triangles));
   if (fi < vi) return BadFile(name, "cannot import: PLY faces come before the vertices");
-  PlyRowReader reader(bytes, *h, name);
+  PlyRowReader reader(bytes, h, name);
   IndexedPolygons polygons;
-  for (std::size_t i = 0; i < h->elements.size(); ++i) {
-    const PlyElement& e = h->elements[i];
+  for (std::size_t i = 0; i < h.elements.size(); ++i) {
+    const PlyElement& e = h.elements[i];
     absl::Status st = static_cast<int>(i) == vi
-                          ? ReadVertices(&reader, *h, e, name, &polygons.vertices)
+                          ? ReadVertices(&reader, h, e, name, &polygons.vertices)
                       : static_cast<int>(i) == fi
-                          ? ReadFaces(&reader, *h, e, h->elements[vi].count, name, &polygons)
+                          ? ReadFaces(&reader, h, e, h.elements[vi].count, name, &polygons)
                           : reader.Skip(e);
     if (!st.ok()) return st;
   }

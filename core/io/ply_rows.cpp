@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/io/text_parse.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
@@ -162,8 +163,7 @@ absl::Status PlyRowReader::Skip(const PlyElement& element) {
     return absl::OkStatus();
   }
   PlyRow row;
-  for (uint64_t r = 0; r < element.count; ++r)
-    if (auto st = Next(element, r, &row); !st.ok()) return st;
+  for (uint64_t r = 0; r < element.count; ++r) RETURN_IF_ERROR(Next(element, r, &row));
   return absl::OkStatus();
 }
 

@@ -16,7 +16,7 @@
 #include "core/distance/mesh_index.h"
 #include "core/errormap/error_map.h"
 #include "core/filter/link_clustering.h"
-#include "core/pipeline/plan_evaluation.h"
+#include "core/plan/plan_evaluation.h"
 #include "core/registration/registration.h"
 
 namespace surfinspect {
@@ -57,17 +57,5 @@ absl::StatusOr<InspectionResult> InspectPart(const MeshIndex& part_in_part,
                                              const InspectionSettings& settings,
                                              const InspectionProgress& progress = {},
                                              const std::atomic<bool>* cancel = nullptr);
-
-// The error-map outputs that travel as bytes (the RPCs and the CLI write the
-// very same bytes): the JSON report text (InspectionReportJson), and the PNG
-// drawn in the part frame (sensor grid for an organized cloud, orthographic
-// view otherwise) with the outcome's defects marked by their ids.
-std::string ErrorMapReportText(const ErrorMapResult& result, const ErrorMapSettings& settings,
-                               const PlanOutcome& outcome);
-absl::StatusOr<std::string> ErrorMapPngBytes(const PointCloud& cloud_in_world,
-                                             const Eigen::Isometry3d& world_from_part,
-                                             const ErrorMapResult& result,
-                                             const TriangleMesh& part_in_part,
-                                             const PlanOutcome& outcome);
 
 }  // namespace surfinspect

@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/types/percentile.h"
+#include "core/types/status_macros.h"
 #include "core/types/transform.h"
 
 namespace surfinspect {
@@ -41,11 +42,10 @@ absl::StatusOr<double> TruncatedCost(const MeshIndex& gauge, const PointCloud& s
   BatchQuerySettings q;
   q.max_distance_mm = cap;
   q.threads = threads;
-  auto closest = QueryClosest(gauge, sample, gauge_from_sensor, q, cancel);
-  if (!closest.ok()) return closest.status();
+  ASSIGN_OR_RETURN(auto closest, QueryClosest(gauge, sample, gauge_from_sensor, q, cancel));
   double sum = 0;
-  for (const auto& c : *closest) sum += c.matched() ? c.distance_mm * c.distance_mm : cap * cap;
-  return sum / double(closest->size());
+  for (const auto& c : closest) sum += c.matched() ? c.distance_mm * c.distance_mm : cap * cap;
+  return sum / double(closest.size());
 }
 
 // The coarse search of CalibrationSettings: rotations about the sensor
@@ -76,9 +76,9 @@ absl::StatusOr<Eigen::Isometry3d> CoarseSearch(const MeshIndex& gauge, const Poi
                       Eigen::AngleAxisd(j * d, Eigen::Vector3d::UnitY()) *
                       Eigen::AngleAxisd(k * d, Eigen::Vector3d::UnitZ()))
                          .toRotationMatrix();
-        auto cost = TruncatedCost(gauge, sample, initial * r, cap, s.icp.threads, cancel);
-        if (!cost.ok()) return cost.status();
-        scored.emplace_back(*cost, initial * r);
+        ASSIGN_OR_RETURN(auto cost,
+                         TruncatedCost(gauge, sample, initial * r, cap, s.icp.threads, cancel));
+        scored.emplace_back(cost, initial * r);
       }
   const std::size_t keep = std::min<std::size_t>(6, scored.size());
   std::partial_sort(scored.begin(), scored.begin() + keep, scored.end(),
@@ -95,10 +95,10 @@ absl::StatusOr<Eigen::Isometry3d> CoarseSearch(const MeshIndex& gauge, const Poi
     auto icp = RunIcp(gauge, sample, scored[c].second, refine, cancel);
     if (icp.status().code() == absl::StatusCode::kCancelled) return icp.status();
     if (!icp.ok()) continue;  // a hopeless candidate: too few pairs
-    auto cost = TruncatedCost(gauge, sample, icp->mesh_from_points, cap, s.icp.threads, cancel);
-    if (!cost.ok()) return cost.status();
-    if (*cost < best_value) {
-      best_value = *cost;
+    ASSIGN_OR_RETURN(
+        auto cost, TruncatedCost(gauge, sample, icp->mesh_from_points, cap, s.icp.threads, cancel));
+    if (cost < best_value) {
+      best_value = cost;
       best = icp->mesh_from_points;
     }
   }
@@ -181,8 +181,8 @@ absl::StatusOr<CalibrationResult> CalibrateViewpoint(
     const MeshIndex& gauge_in_gauge, const Eigen::Isometry3d& world_from_gauge,
     const PointCloud& scan_in_sensor, const Eigen::Isometry3d& initial_world_from_sensor,
     const CalibrationSettings& s, const std::atomic<bool>* cancel) {
-  if (auto st = CheckCalibrationSettings(s); !st.ok()) return st;
-  if (auto st = scan_in_sensor.Validate(); !st.ok()) return st;
+  RETURN_IF_ERROR(CheckCalibrationSettings(s));
+  RETURN_IF_ERROR(scan_in_sensor.Validate());
   CalibrationResult r;
   r.scan_points = scan_in_sensor.CountValid();
   const PointCloud* scan = &scan_in_sensor;
@@ -190,7 +190,7 @@ absl::StatusOr<CalibrationResult> CalibrateViewpoint(
   if (s.filter_outliers) {
     filtered = scan_in_sensor;
     LinkClusteringResult clusters;
-    if (auto st = RemoveOutliers(filtered, s.filter, clusters, cancel); !st.ok()) return st;
+    RETURN_IF_ERROR(RemoveOutliers(filtered, s.filter, clusters, cancel));
     r.filtered_points = clusters.removed;
     scan = &filtered;
   }
@@ -198,14 +198,14 @@ absl::StatusOr<CalibrationResult> CalibrateViewpoint(
   Eigen::Isometry3d initial_gauge_from_sensor =
       world_from_gauge.inverse() * initial_world_from_sensor;
   if (s.coarse_search_deg > 0) {
-    auto coarse = CoarseSearch(gauge_in_gauge, *scan, initial_gauge_from_sensor, s, cancel);
-    if (!coarse.ok()) return coarse.status();
-    r.coarse_rotation_deg = ComparePoses(initial_gauge_from_sensor, *coarse).rotation_deg;
-    initial_gauge_from_sensor = *coarse;
+    ASSIGN_OR_RETURN(auto coarse,
+                     CoarseSearch(gauge_in_gauge, *scan, initial_gauge_from_sensor, s, cancel));
+    r.coarse_rotation_deg = ComparePoses(initial_gauge_from_sensor, coarse).rotation_deg;
+    initial_gauge_from_sensor = coarse;
   }
-  auto icp = RunIcp(gauge_in_gauge, *scan, initial_gauge_from_sensor, s.icp, cancel);
-  if (!icp.ok()) return icp.status();
-  r.icp = *std::move(icp);
+  ASSIGN_OR_RETURN(auto icp,
+                   RunIcp(gauge_in_gauge, *scan, initial_gauge_from_sensor, s.icp, cancel));
+  r.icp = std::move(icp);
   r.gauge_from_sensor = r.icp.mesh_from_points;
   // The paper's eq. (1): world_from_sensor_i = world_from_gauge_i * gauge_from_sensor_i.
   r.world_from_sensor = world_from_gauge * r.gauge_from_sensor;

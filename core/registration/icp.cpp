@@ -9,6 +9,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/registration/absolute_orientation.h"
 #include "core/types/cancel.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
@@ -62,11 +63,10 @@ absl::StatusOr<Pairs> Correspond(const MeshIndex& mesh, const PointCloud& pts,
   BatchQuerySettings q;
   q.max_distance_mm = gate;
   q.threads = s.threads;
-  auto closest = QueryClosest(mesh, pts, pose, q, cancel);
-  if (!closest.ok()) return closest.status();
+  ASSIGN_OR_RETURN(auto closest, QueryClosest(mesh, pts, pose, q, cancel));
   std::vector<double> dist;
-  dist.reserve(closest->size());
-  for (const auto& c : *closest)
+  dist.reserve(closest.size());
+  for (const auto& c : closest)
     if (c.matched()) dist.push_back(c.distance_mm);
   double trim_at = INFINITY;
   if (s.trim_fraction > 0 && !dist.empty()) {
@@ -77,8 +77,8 @@ absl::StatusOr<Pairs> Correspond(const MeshIndex& mesh, const PointCloud& pts,
   }
   Pairs out;
   double sum2 = 0;
-  for (std::size_t i = 0; i < closest->size(); ++i) {
-    const ClosestPoint& c = (*closest)[i];
+  for (std::size_t i = 0; i < closest.size(); ++i) {
+    const ClosestPoint& c = (closest)[i];
     if (!c.matched() || c.distance_mm > trim_at) continue;
     const Eigen::Vector3d p = pose * pts.points[i].cast<double>();
     // Inside a face the plane normal; at an edge or vertex the direction to
@@ -171,8 +171,8 @@ const char* ToString(IcpStopReason reason) {
 absl::StatusOr<IcpResult> RunIcp(const MeshIndex& mesh, const PointCloud& points,
                                  const Eigen::Isometry3d& initial_mesh_from_points,
                                  const IcpSettings& s, const std::atomic<bool>* cancel) {
-  if (auto st = ValidateIcpSettings(s); !st.ok()) return st;
-  if (auto st = points.Validate(); !st.ok()) return st;
+  RETURN_IF_ERROR(ValidateIcpSettings(s));
+  RETURN_IF_ERROR(points.Validate());
   if (!initial_mesh_from_points.matrix().allFinite())
     return absl::InvalidArgumentError("icp: initial pose is not finite");
   const PointCloud pts = Subsample(points, s.max_points, s.seed);
@@ -184,20 +184,19 @@ absl::StatusOr<IcpResult> RunIcp(const MeshIndex& mesh, const PointCloud& points
   double gate = s.max_correspondence_mm, previous_gate = gate;
   for (int it = 0;; ++it) {
     if (IsCancelled(cancel)) return absl::CancelledError("icp cancelled");
-    auto pairs = Correspond(mesh, pts, pose, gate, s, cancel);
-    if (!pairs.ok()) return pairs.status();
-    if (pairs->p.size() < 6)
+    ASSIGN_OR_RETURN(auto pairs, Correspond(mesh, pts, pose, gate, s, cancel));
+    if (pairs.p.size() < 6)
       return absl::FailedPreconditionError(
-          absl::StrCat("icp: only ", pairs->p.size(), " of ", pts.size(), " points within ", gate,
+          absl::StrCat("icp: only ", pairs.p.size(), " of ", pts.size(), " points within ", gate,
                        " mm of the mesh at iteration ", it, "; is the initial pose too far off?"));
     const std::vector<double>& h = result.cost_history;
-    result.cost_history.push_back(pairs->cost);
+    result.cost_history.push_back(pairs.cost);
     result.mesh_from_points = pose;
     result.iterations = it;
-    result.inliers = pairs->p.size();
-    result.rms_mm = std::sqrt(pairs->cost);
+    result.inliers = pairs.p.size();
+    result.rms_mm = std::sqrt(pairs.cost);
     bool stop = false;
-    if (pairs->cost <= s.absolute_cost_mm2) {
+    if (pairs.cost <= s.absolute_cost_mm2) {
       result.stop_reason = IcpStopReason::kAbsoluteCost;
       stop = true;
     } else if (it >= 1) {
@@ -220,21 +219,20 @@ absl::StatusOr<IcpResult> RunIcp(const MeshIndex& mesh, const PointCloud& points
     if (stop || it >= s.max_iterations) {
       result.converged = stop;
       if (!stop) result.stop_reason = IcpStopReason::kMaxIterations;
-      result.normal_matrix = NormalMatrix(*pairs, nullptr);
-      result.residuals_mm.reserve(pairs->p.size());
-      for (std::size_t i = 0; i < pairs->p.size(); ++i) {
-        result.residuals_mm.push_back((pairs->p[i] - pairs->q[i]).dot(pairs->n[i]));
-        result.inlier_centroid += pairs->p[i];
+      result.normal_matrix = NormalMatrix(pairs, nullptr);
+      result.residuals_mm.reserve(pairs.p.size());
+      for (std::size_t i = 0; i < pairs.p.size(); ++i) {
+        result.residuals_mm.push_back((pairs.p[i] - pairs.q[i]).dot(pairs.n[i]));
+        result.inlier_centroid += pairs.p[i];
       }
-      result.inlier_centroid /= double(pairs->p.size());
+      result.inlier_centroid /= double(pairs.p.size());
       double r2 = 0;
-      for (const auto& p : pairs->p) r2 += (p - result.inlier_centroid).squaredNorm();
-      result.inlier_radius_mm = std::sqrt(r2 / pairs->p.size());
+      for (const auto& p : pairs.p) r2 += (p - result.inlier_centroid).squaredNorm();
+      result.inlier_radius_mm = std::sqrt(r2 / pairs.p.size());
       return result;
     }
-    auto delta = Step(*pairs, s);
-    if (!delta.ok()) return delta.status();
-    pose = *delta * pose;
+    ASSIGN_OR_RETURN(auto delta, Step(pairs, s));
+    pose = delta * pose;
     previous_gate = gate;
     gate = std::clamp(4.0 * result.rms_mm, s.min_correspondence_mm, s.max_correspondence_mm);
   }

@@ -2,6 +2,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/types/cancel.h"
+#include "core/types/status_macros.h"
 #include "core/types/transform.h"
 
 namespace surfinspect {
@@ -29,8 +30,8 @@ absl::StatusOr<MergedCloud> RegisterToWorld(const std::vector<ViewScan>& views,
           absl::StrCat("register: view '", v.name, "': ", st.message()));
     // Re-check rigidity: a matrix that slipped past validation would scale
     // the part and fake a shape error.
-    auto rigid = FromRowMajor(ToRowMajor(v.world_from_sensor), "world_from_sensor of " + v.name);
-    if (!rigid.ok()) return rigid.status();
+    RETURN_IF_ERROR(
+        FromRowMajor(ToRowMajor(v.world_from_sensor), "world_from_sensor of " + v.name).status());
     total += v.cloud_in_sensor.CountValid();
   }
   std::vector<Eigen::Vector3f> pts;
@@ -67,10 +68,10 @@ absl::StatusOr<BestFitResult> BestFitToCad(const MeshIndex& part,
                                            const Eigen::Isometry3d& world_from_part,
                                            const MergedCloud& merged, const IcpSettings& settings,
                                            const std::atomic<bool>* cancel) {
-  auto icp = RunIcp(part, merged.cloud_in_world, world_from_part.inverse(), settings, cancel);
-  if (!icp.ok()) return icp.status();
+  ASSIGN_OR_RETURN(
+      auto icp, RunIcp(part, merged.cloud_in_world, world_from_part.inverse(), settings, cancel));
   BestFitResult r;
-  r.icp = *std::move(icp);
+  r.icp = std::move(icp);
   // part_from_world' is what ICP found; world_from_part maps it back, so the
   // correction moves registered world points onto the fitted ones.
   r.correction = world_from_part * r.icp.mesh_from_points;

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <limits>
 
-#include "core/errormap/error_map_output.h"
+#include "core/errormap/deviation_color.h"
 
 namespace surfinspect {
 namespace {

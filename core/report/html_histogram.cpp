@@ -17,17 +17,10 @@ std::string Hex(Rgb c) { return absl::StrFormat("#%02x%02x%02x", c.r, c.g, c.b);
 
 }  // namespace
 
-std::string HistogramSvg(const nlohmann::json& report, const DeviationPalette& palette) {
-  const nlohmann::json h = report.contains("histogram") && report["histogram"].is_object()
-                               ? report["histogram"]
-                               : nlohmann::json::object();
-  std::vector<double> counts;
-  if (h.contains("counts") && h["counts"].is_array())
-    for (const auto& c : h["counts"]) counts.push_back(c.is_number() ? c.get<double>() : 0.0);
-  const auto number = [&](const char* key) {
-    return h.contains(key) && h[key].is_number() ? h[key].get<double>() : 0.0;
-  };
-  const double lo = number("min_mm"), hi = number("max_mm");
+std::string HistogramSvg(const Histogram& h, const DeviationPalette& palette) {
+  const std::vector<double> counts(h.counts.begin(), h.counts.end());
+  const double lo = std::isfinite(h.min_mm) ? h.min_mm : 0.0;
+  const double hi = std::isfinite(h.max_mm) ? h.max_mm : 0.0;
   if (counts.empty() || !(hi > lo)) return "<p id=\"histogram\" class=\"none\">no histogram</p>\n";
   double top = 0;
   for (double c : counts) top = std::max(top, std::log10(1 + c));
@@ -65,16 +58,12 @@ std::string HistogramSvg(const nlohmann::json& report, const DeviationPalette& p
                           x_of(mm), x_of(mm), kTop + plot_h, kTop + plot_h + 4, x_of(mm),
                           kHeight - 6, mm);
   }
-  absl::StrAppendFormat(
-      &out,
-      "<text x=\"2\" y=\"%.2f\">log</text>"
-      "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"end\">tallest bin %.0f; "
-      "below the range %s, above %s</text>\n</svg>\n",
-      kTop + plot_h / 2, kWidth - 4, kTop - 5, std::pow(10, top) - 1,
-      HtmlEscape(h.value("below_range", nlohmann::json(0))
-                     .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)),
-      HtmlEscape(h.value("above_range", nlohmann::json(0))
-                     .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)));
+  absl::StrAppendFormat(&out,
+                        "<text x=\"2\" y=\"%.2f\">log</text>"
+                        "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"end\">tallest bin %.0f; "
+                        "below the range %s, above %s</text>\n</svg>\n",
+                        kTop + plot_h / 2, kWidth - 4, kTop - 5, std::pow(10, top) - 1,
+                        absl::StrCat(h.below_range), absl::StrCat(h.above_range));
   return out;
 }
 

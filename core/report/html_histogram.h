@@ -5,15 +5,14 @@
 // mm labels at -range, -tol, 0, +tol and +range.
 #pragma once
 
-#include <nlohmann/json.hpp>
 #include <string>
 
+#include "core/errormap/error_map.h"
 #include "core/report/deviation_palette.h"
 
 namespace surfinspect {
 
-// `report` is report.json's object ("histogram": {min_mm, max_mm, counts,
-// below_range, above_range}); an empty histogram gives a short note.
-std::string HistogramSvg(const nlohmann::json& report, const DeviationPalette& palette);
+// The report's histogram; an empty one gives a short note.
+std::string HistogramSvg(const Histogram& histogram, const DeviationPalette& palette);
 
 }  // namespace surfinspect

@@ -10,6 +10,7 @@
 #include "core/report/html_histogram.h"
 #include "core/report/viewer_assets.h"
 #include "core/report/viewer_page.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
@@ -17,8 +18,8 @@ namespace {
 using nlohmann::json;
 
 // What the viewer reads: scale, palette, the payload's layout, defects.
-json ViewerData(const json& report, const HtmlReportContext& ctx, const DeviationPalette& palette,
-                const HtmlPayload& p, std::string& blob) {
+json ViewerData(const InspectionReport& report, const HtmlReportContext& ctx,
+                const DeviationPalette& palette, const HtmlPayload& p, std::string& blob) {
   json data = {{"kind", "report"},
                {"part_id", ctx.part_id},
                {"cell", ctx.cell},
@@ -42,54 +43,48 @@ json ViewerData(const json& report, const HtmlReportContext& ctx, const Deviatio
   data["mesh_omitted"] = p.mesh_omitted;
   if (!p.mesh_triangles.empty()) data["mesh"] = MeshJson(p.mesh_vertices, p.mesh_triangles, blob);
   data["defects"] = json::array();
-  if (report.contains("defects") && report["defects"].is_array())
-    for (const json& d : report["defects"])
-      if (d.is_object())
-        data["defects"].push_back({{"id", d.value("id", json())},
-                                   {"kind", d.value("kind", json())},
-                                   {"centroid_mm", d.value("centroid_mm", json())},
-                                   {"extent_mm", d.value("extent_mm", json())},
-                                   {"peak_mm", d.value("peak_mm", json())},
-                                   {"region", d.value("region", json())}});
+  for (const ReportDefect& d : report.defects)
+    data["defects"].push_back(
+        {{"id", d.id},
+         {"kind", d.kind},
+         {"centroid_mm", {d.centroid_mm.x(), d.centroid_mm.y(), d.centroid_mm.z()}},
+         {"extent_mm", d.extent_mm},
+         {"peak_mm", d.peak_mm},
+         {"region", d.region}});
   return data;
 }
 
-std::string Title(const HtmlReportContext& ctx, const json& report) {
-  const std::string verdict = report.contains("verdict") && report["verdict"].is_string()
-                                  ? report["verdict"].get<std::string>()
-                                  : "?";
+std::string Title(const HtmlReportContext& ctx, const InspectionReport& report) {
+  const std::string verdict = report.verdict.empty() ? "?" : report.verdict;
   return absl::StrCat("surfinspect report: ", ctx.part_id, " (", verdict, ")");
 }
 
-std::string SidePane(const json& report, const HtmlReportContext& ctx,
+std::string SidePane(const InspectionReport& report, const HtmlReportContext& ctx,
                      const DeviationPalette& palette) {
   return absl::StrCat("<aside id=\"side\">\n<h2>Characteristics</h2>\n",
                       CharacteristicsTable(report), "<h2>Defects</h2>\n", DefectsTable(report),
-                      "<h2>Histogram</h2>\n", HistogramSvg(report, palette),
+                      "<h2>Histogram</h2>\n", HistogramSvg(report.histogram, palette),
                       "<h2>Statistics (all points)</h2>\n", StatisticsTable(report),
                       "<h2>Calibration</h2>\n", CalibrationTable(ctx), "<h2>Settings</h2>\n",
                       SettingsTable(report), "</aside>\n");
 }
 
 absl::Status CheckInput(const HtmlReportInput& in) {
-  if (!in.report || !in.report->is_object())
-    return absl::InvalidArgumentError("HTML report: no report object");
+  if (!in.report) return absl::InvalidArgumentError("HTML report: no report object");
   if (!in.points_in_part || !in.deviation_mm)
     return absl::InvalidArgumentError("HTML report: no points or deviations");
-  const json& r = *in.report;
-  if (!r.contains("tolerance") || !r["tolerance"].contains("band_mm") ||
-      !r["tolerance"]["band_mm"].is_number() || !(r["tolerance"]["band_mm"].get<double>() > 0))
+  if (!(in.report->tolerance.band_mm > 0))
     return absl::InvalidArgumentError("HTML report: report lacks tolerance.band_mm");
-  if (!r.contains("color_range_mm") || !r["color_range_mm"].is_number())
+  if (!std::isfinite(in.report->color_range_mm))
     return absl::InvalidArgumentError("HTML report: report lacks color_range_mm");
   return absl::OkStatus();
 }
 
 absl::StatusOr<HtmlReportPage> BuildPage(const HtmlReportInput& in) {
-  const json& report = *in.report;
+  const InspectionReport& report = *in.report;
   const auto t0 = std::chrono::steady_clock::now();
-  const DeviationPalette palette = MakeDeviationPalette(
-      report["tolerance"]["band_mm"].get<double>(), report["color_range_mm"].get<double>());
+  const DeviationPalette palette =
+      MakeDeviationPalette(report.tolerance.band_mm, report.color_range_mm);
   auto payload =
       BuildHtmlPayload(*in.points_in_part, *in.deviation_mm, palette, in.mesh_in_part, in.payload);
   if (!payload.ok()) return payload.status();
@@ -112,18 +107,13 @@ absl::StatusOr<HtmlReportPage> BuildPage(const HtmlReportInput& in) {
 }  // namespace
 
 absl::StatusOr<HtmlReportPage> BuildHtmlReport(const HtmlReportInput& in) {
-  if (auto st = CheckInput(in); !st.ok()) return st;
-  try {
-    return BuildPage(in);
-  } catch (const json::exception& e) {  // a report field of an unexpected type
-    return absl::InvalidArgumentError(absl::StrCat("HTML report: malformed report: ", e.what()));
-  }
+  RETURN_IF_ERROR(CheckInput(in));
+  return BuildPage(in);
 }
 
 absl::Status WriteHtmlReport(const std::string& path, const HtmlReportInput& input) {
-  auto page = BuildHtmlReport(input);
-  if (!page.ok()) return page.status();
-  return WriteStringAtomically(path, page->html);
+  ASSIGN_OR_RETURN(auto page, BuildHtmlReport(input));
+  return WriteStringAtomically(path, page.html);
 }
 
 }  // namespace surfinspect

@@ -27,7 +27,7 @@
 namespace surfinspect {
 
 struct HtmlReportInput {
-  const nlohmann::json* report = nullptr;  // report.json's object (surfinspect.report/2)
+  const InspectionReport* report = nullptr;  // with its plan, or an error map's alone
   const PointCloud* points_in_part = nullptr;
   const std::vector<float>* deviation_mm = nullptr;  // per point of points_in_part
   const TriangleMesh* mesh_in_part = nullptr;        // optional overlay

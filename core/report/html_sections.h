@@ -1,13 +1,14 @@
-// The HTML report's panels beside the 3D viewer, built from report.json
-// ("schema": "surfinspect.report/2", docs/inspection-plan.md) and the part's
-// context. Every string taken from the report or the context is escaped
-// (core/report/html_escape.h). Numbers the page's tests read back carry
+// The HTML report's panels beside the 3D viewer, built from the typed report
+// (core/pipeline/inspection_report.h) and the part's context. Every string taken from the report or
+// the context is escaped (core/report/html_escape.h). Numbers the page's tests read back carry
 // their exact JSON text in a data-value attribute.
 #pragma once
 
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
+
+#include "core/pipeline/inspection_report.h"
 
 namespace surfinspect {
 
@@ -26,19 +27,20 @@ struct HtmlReportContext {
 };
 
 // The part verdict banner: part id, cell, verdict, the tolerance reason.
-std::string VerdictBanner(const nlohmann::json& report, const HtmlReportContext& context);
+std::string VerdictBanner(const InspectionReport& report, const HtmlReportContext& context);
 
 // Characteristics, failed rows first (otherwise in the report's order).
-std::string CharacteristicsTable(const nlohmann::json& report);
+std::string CharacteristicsTable(const InspectionReport& report);
 
 // Defects, one row per defect with data-defect="ID" (the viewer flies there).
-std::string DefectsTable(const nlohmann::json& report);
+std::string DefectsTable(const InspectionReport& report);
 
-// Statistics over all points (report "points" and "statistics").
-std::string StatisticsTable(const nlohmann::json& report);
+// Statistics over all points: the point counts, the statistics and the
+// +-band counts, each with its report key.
+std::string StatisticsTable(const InspectionReport& report);
 
-// Every key of report "settings" (and "inputs", the file names, when present).
-std::string SettingsTable(const nlohmann::json& report);
+// The report's settings (and inputs, the file names, when present).
+std::string SettingsTable(const InspectionReport& report);
 
 std::string CalibrationTable(const HtmlReportContext& context);
 

@@ -7,12 +7,13 @@
 #include "absl/strings/str_format.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
-#include "core/errormap/error_map_output.h"
-#include "core/errormap/error_map_panel.h"
-#include "core/errormap/error_map_png.h"
+#include "core/errormap/deviation_color.h"
 #include "core/io/atomic_file.h"
+#include "core/report/error_map_panel.h"
+#include "core/report/error_map_png.h"
 #include "core/report/pdf_canvas.h"
 #include "core/report/report_content.h"
+#include "core/types/status_macros.h"
 #include "core/types/transform.h"
 
 #ifndef SURFINSPECT_VERSION
@@ -93,26 +94,25 @@ absl::StatusOr<std::vector<std::pair<std::string, RgbImage>>> MapViews(const Pdf
   std::vector<std::pair<std::string, RgbImage>> out;
   auto add = [&](const std::string& caption, const PointCloud& cloud, int axis) -> absl::Status {
     options.view_axis = axis;
-    auto map = RenderErrorMapView(cloud, view, ComputeBounds(cloud), options);
-    if (!map.ok()) return map.status();
-    out.emplace_back(caption, *std::move(map));
+    ASSIGN_OR_RETURN(auto map, RenderErrorMapView(cloud, view, ComputeBounds(cloud), options));
+    out.emplace_back(caption, std::move(map));
     return absl::OkStatus();
   };
   if (pts.organized()) {
     options.max_map_pixels = 1000;
-    if (auto st = add("sensor grid (single view)", pts, -1); !st.ok()) return st;
+    RETURN_IF_ERROR(add("sensor grid (single view)", pts, -1));
     return out;
   }
   options.max_map_pixels = 900;
-  if (auto st = add("top: view along -z", pts, 2); !st.ok()) return st;
+  RETURN_IF_ERROR(add("top: view along -z", pts, 2));
   // (x, y, z) -> (-y, x, z): depth -y (nearest the viewer at -y wins), right x, up z.
   const Eigen::Isometry3d turn(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()));
   std::vector<Defect> turned = c.defect_marks;
   for (Defect& d : turned) d.centroid_mm = turn * d.centroid_mm;
   options.defects = &turned;
-  if (auto st = add("front: view along +y", TransformCloud(pts, turn), 0); !st.ok()) return st;
+  RETURN_IF_ERROR(add("front: view along +y", TransformCloud(pts, turn), 0));
   options.defects = &c.defect_marks;
-  if (auto st = add("side: view along -x", pts, 0); !st.ok()) return st;
+  RETURN_IF_ERROR(add("side: view along -x", pts, 0));
   return out;
 }
 
@@ -120,14 +120,13 @@ absl::StatusOr<std::vector<std::pair<std::string, RgbImage>>> MapViews(const Pdf
 // and all shrunk by one factor when their heights do not fit.
 absl::Status DrawMaps(PdfCanvas& cv, const PdfReportInput& in, const ReportContent& c, double x,
                       double y, double w, double h) {
-  auto views = MapViews(in, c);
-  if (!views.ok()) return views.status();
+  ASSIGN_OR_RETURN(auto views, MapViews(in, c));
   constexpr double kCaption = 11, kGap = 4;
   double natural = 0;
-  for (const auto& [caption, map] : *views) natural += w * map.height / map.width;
-  const double room = h - views->size() * (kCaption + kGap);
+  for (const auto& [caption, map] : views) natural += w * map.height / map.width;
+  const double room = h - views.size() * (kCaption + kGap);
   const double shrink = std::min(1.0, room / natural);
-  for (const auto& [caption, map] : *views) {
+  for (const auto& [caption, map] : views) {
     cv.Text(x, y, caption, {7.5, false, kGrey});
     const double iw = w * shrink, ih = iw * map.height / map.width;
     cv.Image(map, x + (w - iw) / 2, y + kCaption, iw, ih);
@@ -241,17 +240,15 @@ absl::StatusOr<std::string> RenderPdfReport(const PdfReportInput& in) {
     return absl::InvalidArgumentError(absl::StrCat("pdf report: ", in.points_in_part->size(),
                                                    " points but ", in.deviation_mm->size(),
                                                    " deviations"));
-  auto content = ReportContentFromJson(*in.report);
-  if (!content.ok()) return content.status();
-  const ReportContent& c = *content;
-  auto canvas = PdfCanvas::Create(absl::StrCat("surfinspect report: ", in.part_id));
-  if (!canvas.ok()) return canvas.status();
-  Pages p{**canvas, absl::StrCat(SoftwareVersion(), " \xC2\xB7 part ", in.part_id)};
+  ASSIGN_OR_RETURN(auto content, ReportContentFrom(*in.report));
+  const ReportContent& c = content;
+  ASSIGN_OR_RETURN(auto canvas,
+                   PdfCanvas::Create(absl::StrCat("surfinspect report: ", in.part_id)));
+  Pages p{*canvas, absl::StrCat(SoftwareVersion(), " \xC2\xB7 part ", in.part_id)};
   p.Footer();
   DrawHeader(p, in, c);
   const double map_h = 430, legend_x = kLeft + 385;
-  if (auto st = DrawMaps(p.canvas, in, c, kLeft, p.y, legend_x - kLeft - 10, map_h); !st.ok())
-    return st;
+  RETURN_IF_ERROR(DrawMaps(p.canvas, in, c, kLeft, p.y, legend_x - kLeft - 10, map_h));
   DrawLegend(p.canvas, c, legend_x, p.y + 30, p.y + map_h - 30);
   p.y += map_h + 8;
   DrawStatistics(p, c);
@@ -262,9 +259,8 @@ absl::StatusOr<std::string> RenderPdfReport(const PdfReportInput& in) {
 }
 
 absl::Status WritePdfReport(const std::string& path, const PdfReportInput& input) {
-  auto bytes = RenderPdfReport(input);
-  if (!bytes.ok()) return bytes.status();
-  return WriteStringAtomically(path, *bytes);
+  ASSIGN_OR_RETURN(auto bytes, RenderPdfReport(input));
+  return WriteStringAtomically(path, bytes);
 }
 
 }  // namespace surfinspect

@@ -7,15 +7,15 @@
 // log-count histogram on the same deviation axis, and the statistics. Then
 // the characteristics table (failed rows first) and the defects table,
 // continued on as many pages as they need. The content comes from the
-// report JSON (core/report/report_content.h); the maps are drawn by
-// core/errormap/error_map_png.h's renderer.
+// typed report (core/report/report_content.h); the maps are drawn by
+// core/report/error_map_png.h's renderer.
 #pragma once
 
-#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "core/pipeline/inspection_report.h"
 #include "core/types/point_cloud.h"
 
 namespace surfinspect {
@@ -24,7 +24,7 @@ struct PdfReportInput {
   std::string part_id;
   std::string cell;                                  // "" = not given
   std::string time_utc;                              // e.g. "2026-12-01 11:40:00 UTC"; "" = now
-  const nlohmann::json* report = nullptr;            // report.json, or the errormap report
+  const InspectionReport* report = nullptr;          // with a plan, or an error map's alone
   const PointCloud* points_in_part = nullptr;        // the scanned cloud, part frame, mm
   const std::vector<float>* deviation_mm = nullptr;  // per point of points_in_part
 };

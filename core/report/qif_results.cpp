@@ -7,7 +7,6 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
-#include <nlohmann/json.hpp>
 #include <pugixml.hpp>
 #include <sstream>
 #include <vector>
@@ -15,11 +14,10 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "core/io/atomic_file.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
-
-using nlohmann::json;
 
 // Fixed QIF ids; characteristic k uses kFirstCharacteristicId + 4k .. + 3.
 constexpr int kStandardId = 1, kDeviceId = 2, kPartId = 3, kResultsId = 4, kComponentId = 5;
@@ -59,41 +57,37 @@ struct Characteristic {
   const char* qif_kind() const { return type == "point" ? "PointProfile" : "SurfaceProfile"; }
 };
 
-absl::StatusOr<Characteristic> ReadCharacteristic(const json& c, std::size_t k) {
+absl::StatusOr<Characteristic> ReadCharacteristic(const ReportCharacteristic& c, std::size_t k) {
   const std::string where = absl::StrCat("report.characteristics[", k, "]");
-  try {
-    Characteristic out;
-    out.name = c.at("name").get<std::string>();
-    out.type = c.at("type").get<std::string>();
-    out.verdict = c.at("verdict").get<std::string>();
-    out.reason = c.value("reason", "");
-    out.lower = c.at("tolerance_mm").at("lower").get<double>();
-    out.upper = c.at("tolerance_mm").at("upper").get<double>();
-    out.has_values = c.value("points", 0) > 0 && c.at("min_mm").is_number();
-    if (out.has_values) {
-      out.min_mm = c.at("min_mm").get<double>();
-      out.max_mm = c.at("max_mm").get<double>();
-      if (out.type == "point") out.value_mm = c.at("value_mm").get<double>();
-    }
-    if (out.type != "surface" && out.type != "region" && out.type != "point")
-      return absl::InvalidArgumentError(absl::StrCat(where, ".type: unknown \"", out.type, "\""));
-    if (out.verdict != "pass" && out.verdict != "fail")
-      return absl::InvalidArgumentError(absl::StrCat(where, ".verdict: not pass/fail"));
-    return out;
-  } catch (const json::exception& e) {
-    return absl::InvalidArgumentError(absl::StrCat(where, ": ", e.what()));
+  Characteristic out;
+  out.name = c.name;
+  out.type = c.type;
+  out.verdict = c.verdict;
+  out.reason = c.reason;
+  out.lower = c.tolerance.lower_mm;
+  out.upper = c.tolerance.upper_mm;
+  out.has_values = c.points > 0 && std::isfinite(c.min_mm);
+  if (out.has_values) {
+    out.min_mm = c.min_mm;
+    out.max_mm = c.max_mm;
+    if (out.type == "point") out.value_mm = c.value_mm;
+    if (!std::isfinite(out.max_mm) || !std::isfinite(out.value_mm))
+      return absl::InvalidArgumentError(absl::StrCat(where, ": points without values"));
   }
+  if (!std::isfinite(out.lower) || !std::isfinite(out.upper))
+    return absl::InvalidArgumentError(absl::StrCat(where, ".tolerance_mm: missing"));
+  if (out.type != "surface" && out.type != "region" && out.type != "point")
+    return absl::InvalidArgumentError(absl::StrCat(where, ".type: unknown \"", out.type, "\""));
+  if (out.verdict != "pass" && out.verdict != "fail")
+    return absl::InvalidArgumentError(absl::StrCat(where, ".verdict: not pass/fail"));
+  return out;
 }
 
-absl::StatusOr<std::vector<Characteristic>> ReadCharacteristics(const json& report) {
-  if (!report.contains("characteristics") || !report["characteristics"].is_array())
-    return absl::InvalidArgumentError("report: no characteristics array");
+absl::StatusOr<std::vector<Characteristic>> ReadCharacteristics(const InspectionReport& report) {
   std::vector<Characteristic> out;
-  const json& cs = report["characteristics"];
-  for (std::size_t k = 0; k < cs.size(); ++k) {
-    auto c = ReadCharacteristic(cs[k], k);
-    if (!c.ok()) return c.status();
-    out.push_back(*std::move(c));
+  for (std::size_t k = 0; k < report.characteristics.size(); ++k) {
+    ASSIGN_OR_RETURN(auto c, ReadCharacteristic(report.characteristics[k], k));
+    out.push_back(std::move(c));
   }
   return out;
 }
@@ -208,19 +202,15 @@ void AddResults(pugi::xml_node doc, const std::vector<Characteristic>& cs,
 
 }  // namespace
 
-absl::StatusOr<std::string> QifResultsXml(const std::string& report_json, const QifContext& ctx) {
+absl::StatusOr<std::string> QifResultsXml(const InspectionReport& report, const QifContext& ctx) {
   if (ctx.part_id.empty()) return absl::InvalidArgumentError("QIF: no part id");
   if (ctx.cell.empty()) return absl::InvalidArgumentError("QIF: no cell name");
-  const json report = json::parse(report_json, nullptr, false);
-  if (report.is_discarded() || !report.is_object())
-    return absl::InvalidArgumentError("report is not a JSON object");
-  if (report.value("schema", "") != "surfinspect.report/2")
-    return absl::InvalidArgumentError("report: schema is not surfinspect.report/2");
-  const std::string verdict = report.value("verdict", "");
+  if (report.schema != kReportSchema)
+    return absl::InvalidArgumentError(absl::StrCat("report: schema is not ", kReportSchema));
+  const std::string& verdict = report.verdict;
   if (verdict != "pass" && verdict != "fail")
     return absl::InvalidArgumentError("report.verdict: not pass/fail");
-  auto cs = ReadCharacteristics(report);
-  if (!cs.ok()) return cs.status();
+  ASSIGN_OR_RETURN(auto cs, ReadCharacteristics(report));
   pugi::xml_document xml;
   pugi::xml_node decl = xml.append_child(pugi::node_declaration);
   decl.append_attribute("version").set_value("1.0");
@@ -228,21 +218,19 @@ absl::StatusOr<std::string> QifResultsXml(const std::string& report_json, const 
   pugi::xml_node doc = xml.append_child("QIFDocument");
   doc.append_attribute("xmlns").set_value("http://qifstandards.org/xsd/qif3");
   doc.append_attribute("versionQIF").set_value("3.0.0");
-  doc.append_attribute("idMax").set_value(kFirstCharacteristicId +
-                                          4 * static_cast<int>(cs->size()));
+  doc.append_attribute("idMax").set_value(kFirstCharacteristicId + 4 * static_cast<int>(cs.size()));
   AddPreamble(doc, ctx);
-  AddCharacteristics(doc, *cs, ModelOf(ctx));
-  AddResults(doc, *cs, verdict, ctx);
+  AddCharacteristics(doc, cs, ModelOf(ctx));
+  AddResults(doc, cs, verdict, ctx);
   std::ostringstream out;
   xml.save(out, "  ", pugi::format_default, pugi::encoding_utf8);
   return out.str();
 }
 
-absl::Status WriteQifResults(const std::string& path, const std::string& report_json,
+absl::Status WriteQifResults(const std::string& path, const InspectionReport& report,
                              const QifContext& context) {
-  auto xml = QifResultsXml(report_json, context);
-  if (!xml.ok()) return xml.status();
-  return WriteStringAtomically(path, *xml);
+  ASSIGN_OR_RETURN(auto xml, QifResultsXml(report, context));
+  return WriteStringAtomically(path, xml);
 }
 
 std::string QifUuid(const std::string& name) {

@@ -1,8 +1,8 @@
 // One inspected part as a QIF 3.0 (ISO 23952) document, for quality systems
 // that import QIF Results (PiWeb, PolyWorks DataLoop, CMM suites) without a
-// parser of their own. Input is the part's report.json
-// (surfinspect.report/2); the XML is built with pugixml and validates against
-// the QIF 3.0 XSD (QIFApplications/QIFDocument.xsd).
+// parser of their own. Input is the part's typed report
+// (core/pipeline/inspection_report.h, with its plan); the XML is built with pugixml and validates
+// against the QIF 3.0 XSD (QIFApplications/QIFDocument.xsd).
 //
 // Mapping (millimetres, FileUnits say so):
 //   - Product/PartSet/Part: the part type the cell inspects; Results'
@@ -39,6 +39,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "core/pipeline/inspection_report.h"
 
 namespace surfinspect {
 
@@ -54,13 +55,13 @@ struct QifContext {
 };
 
 // The QIF document's text. InvalidArgument when the report is not a
-// surfinspect.report/2 JSON object with a verdict and characteristics, or
-// the context lacks the part id or the cell.
-absl::StatusOr<std::string> QifResultsXml(const std::string& report_json,
+// surfinspect.report/2 with a pass/fail verdict and well-formed
+// characteristics, or the context lacks the part id or the cell.
+absl::StatusOr<std::string> QifResultsXml(const InspectionReport& report,
                                           const QifContext& context);
 
 // QifResultsXml written atomically to `path`.
-absl::Status WriteQifResults(const std::string& path, const std::string& report_json,
+absl::Status WriteQifResults(const std::string& path, const InspectionReport& report,
                              const QifContext& context);
 
 // A name-based UUID (ISO/IEC 9834-8 / RFC 4122 version 5, SHA-1) of `name`

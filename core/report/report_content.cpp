@@ -10,129 +10,95 @@
 namespace surfinspect {
 namespace {
 
-using nlohmann::json;
-
-double Num(const json& j, const char* key) {
-  const auto it = j.find(key);
-  return it != j.end() && it->is_number() ? it->get<double>() : NAN;
-}
-
-std::string Str(const json& j, const char* key) {
-  const auto it = j.find(key);
-  return it != j.end() && it->is_string() ? it->get<std::string>() : std::string();
-}
-
-std::string Count(const json& j, const char* key) {
-  const auto it = j.find(key);
-  return it != j.end() && it->is_number_unsigned() ? absl::StrCat(it->get<std::size_t>()) : "-";
-}
+std::string Count(std::size_t n) { return absl::StrCat(n); }
 
 std::string Percent(double fraction) {
   return std::isfinite(fraction) ? absl::StrFormat("%.2f %%", 100 * fraction) : "-";
 }
 
-// A member object, or an empty one when absent (its values print as "-").
-const json& Object(const json& j, const char* key) {
-  static const json kEmpty = json::object();
-  const auto it = j.find(key);
-  return it != j.end() && it->is_object() ? *it : kEmpty;
-}
+// Counts that are all zero come from a report without its "points"
+// section (a part with no point at all is refused before a report): dashes.
+std::string CountOrDash(std::size_t n, bool known) { return known ? Count(n) : "-"; }
 
-void AddStatistics(const json& report, ReportContent& c) {
-  const json& pts = Object(report, "points");
-  const json& st = Object(report, "statistics");
-  const json& tol = Object(report, "tolerance");
-  c.statistics = {{"points", Count(pts, "count")},
-                  {"valid", Count(pts, "valid")},
-                  {"matched", Count(pts, "matched")},
+void AddStatistics(const InspectionReport& r, ReportContent& c) {
+  const ErrorMapStats& st = r.stats;
+  const bool counted = st.count > 0 || st.valid > 0 || st.matched > 0;
+  const ReportTolerance& tol = r.tolerance;
+  c.statistics = {{"points", CountOrDash(st.count, counted)},
+                  {"valid", CountOrDash(st.valid, counted)},
+                  {"matched", CountOrDash(st.matched, counted)},
                   {"tolerance", absl::StrCat("+-", FormatMm(c.tolerance_mm).substr(1), " mm")},
-                  {"in tolerance", Percent(Num(tol, "fraction_within"))},
-                  {"above/below", absl::StrCat(Count(tol, "above"), " / ", Count(tol, "below"))},
-                  {"min", FormatMm(Num(st, "min_mm"))},
-                  {"max", FormatMm(Num(st, "max_mm"))},
-                  {"mean", FormatMm(Num(st, "mean_mm"))},
-                  {"std dev", FormatMm(Num(st, "stddev_mm"))},
-                  {"rms", FormatMm(Num(st, "rms_mm"))},
-                  {"p1", FormatMm(Num(st, "p1_mm"))},
-                  {"p5", FormatMm(Num(st, "p5_mm"))},
-                  {"p50", FormatMm(Num(st, "p50_mm"))},
-                  {"p95", FormatMm(Num(st, "p95_mm"))},
-                  {"p99", FormatMm(Num(st, "p99_mm"))}};
+                  {"in tolerance", Percent(tol.fraction_within)},
+                  {"above/below", absl::StrCat(Count(tol.above), " / ", Count(tol.below))},
+                  {"min", FormatMm(st.min_mm)},
+                  {"max", FormatMm(st.max_mm)},
+                  {"mean", FormatMm(st.mean_mm)},
+                  {"std dev", FormatMm(st.stddev_mm)},
+                  {"rms", FormatMm(st.rms_mm)},
+                  {"p1", FormatMm(st.p1_mm)},
+                  {"p5", FormatMm(st.p5_mm)},
+                  {"p50", FormatMm(st.p50_mm)},
+                  {"p95", FormatMm(st.p95_mm)},
+                  {"p99", FormatMm(st.p99_mm)}};
 }
 
 // Failed rows first, each group in the report's order.
-void AddCharacteristics(const json& list, ReportContent& c) {
+void AddCharacteristics(const std::vector<ReportCharacteristic>& list, ReportContent& c) {
   ReportTable& t = c.characteristics;
   t.header = {"characteristic", "type",   "verdict", "tolerance mm", "value / mean mm",
               "min mm",         "max mm", "in tol",  "points"};
   std::vector<std::size_t> order(list.size());
   std::iota(order.begin(), order.end(), 0);
   std::stable_partition(order.begin(), order.end(),
-                        [&](std::size_t i) { return Str(list[i], "verdict") != "pass"; });
+                        [&](std::size_t i) { return !list[i].passed(); });
   for (std::size_t i : order) {
-    const json& ch = list[i];
-    const json& tol = ch.at("tolerance_mm");
-    const bool point = Str(ch, "type") == "point";
-    t.rows.push_back({Str(ch, "name"), Str(ch, "type"), Str(ch, "verdict"),
-                      absl::StrCat(FormatMm(Num(tol, "lower")), " / ", FormatMm(Num(tol, "upper"))),
-                      FormatMm(Num(ch, point ? "value_mm" : "mean_mm")),
-                      FormatMm(Num(ch, "min_mm")), FormatMm(Num(ch, "max_mm")),
-                      Percent(Num(ch, "fraction_within")), Count(ch, "points")});
-    t.failed.push_back(Str(ch, "verdict") != "pass");
+    const ReportCharacteristic& ch = list[i];
+    t.rows.push_back(
+        {ch.name, ch.type, ch.verdict,
+         absl::StrCat(FormatMm(ch.tolerance.lower_mm), " / ", FormatMm(ch.tolerance.upper_mm)),
+         FormatMm(ch.is_point() ? ch.value_mm : ch.mean_mm), FormatMm(ch.min_mm),
+         FormatMm(ch.max_mm), Percent(ch.fraction_within), Count(ch.points)});
+    t.failed.push_back(!ch.passed());
   }
 }
 
-void AddDefects(const json& list, ReportContent& c) {
+void AddDefects(const std::vector<ReportDefect>& list, ReportContent& c) {
   ReportTable& t = c.defects;
   t.header = {"defect",   "kind",      "region", "peak mm",
               "area mm2", "extent mm", "points", "centroid mm (part)"};
-  for (const json& d : list) {
+  for (const ReportDefect& d : list) {
     Defect mark;
-    mark.id = d.at("id").get<int>();
-    const json& ctr = d.at("centroid_mm");
-    mark.centroid_mm = {ctr.at(0).get<double>(), ctr.at(1).get<double>(), ctr.at(2).get<double>()};
+    mark.id = d.id;
+    mark.centroid_mm = d.centroid_mm;
     c.defect_marks.push_back(mark);
-    t.rows.push_back({absl::StrCat(mark.id), Str(d, "kind"), Str(d, "region"),
-                      FormatMm(Num(d, "peak_mm")), absl::StrFormat("%.1f", Num(d, "area_mm2")),
-                      absl::StrFormat("%.1f", Num(d, "extent_mm")), Count(d, "points"),
-                      absl::StrFormat("%.1f, %.1f, %.1f", mark.centroid_mm.x(),
-                                      mark.centroid_mm.y(), mark.centroid_mm.z())});
+    t.rows.push_back({absl::StrCat(d.id), d.kind, d.region, FormatMm(d.peak_mm),
+                      absl::StrFormat("%.1f", d.area_mm2), absl::StrFormat("%.1f", d.extent_mm),
+                      Count(d.points),
+                      absl::StrFormat("%.1f, %.1f, %.1f", d.centroid_mm.x(), d.centroid_mm.y(),
+                                      d.centroid_mm.z())});
     t.failed.push_back(true);
   }
-}
-
-void ReadHistogram(const json& h, Histogram& out) {
-  out.min_mm = h.at("min_mm").get<double>();
-  out.max_mm = h.at("max_mm").get<double>();
-  out.counts = h.at("counts").get<std::vector<std::size_t>>();
-  out.below_range = h.value("below_range", std::size_t{0});
-  out.above_range = h.value("above_range", std::size_t{0});
 }
 
 }  // namespace
 
 std::string FormatMm(double v) { return std::isfinite(v) ? absl::StrFormat("%+.3f", v) : "-"; }
 
-absl::StatusOr<ReportContent> ReportContentFromJson(const nlohmann::json& report) {
+absl::StatusOr<ReportContent> ReportContentFrom(const InspectionReport& report) {
   ReportContent c;
-  try {
-    const json& tol = report.at("tolerance");
-    c.tolerance_mm = tol.at("band_mm").get<double>();
-    c.color_range_mm = report.at("color_range_mm").get<double>();
-    c.reason = Str(tol, "reason");
-    // A plan's part verdict when there is one, else the +-tolerance verdict.
-    c.verdict = report.contains("verdict") ? report.at("verdict").get<std::string>()
-                                           : tol.at("verdict").get<std::string>();
-    c.pass = c.verdict == "pass";
-    AddStatistics(report, c);
-    if (report.contains("histogram")) ReadHistogram(report.at("histogram"), c.histogram);
-    if (report.contains("characteristics")) AddCharacteristics(report["characteristics"], c);
-    if (report.contains("defects")) AddDefects(report["defects"], c);
-  } catch (const json::exception& e) {
-    return absl::DataLossError(absl::StrCat("report: ", e.what()));
-  }
+  c.tolerance_mm = report.tolerance.band_mm;
+  c.color_range_mm = report.color_range_mm;
   if (!(c.tolerance_mm > 0) || !(c.color_range_mm > 0))
     return absl::DataLossError("report: tolerance.band_mm and color_range_mm must be > 0");
+  c.reason = report.tolerance.reason;
+  // A plan's part verdict when there is one, else the +-tolerance verdict.
+  c.verdict = !report.verdict.empty() ? report.verdict : report.tolerance.verdict;
+  if (c.verdict.empty()) return absl::DataLossError("report: no verdict (nor tolerance.verdict)");
+  c.pass = c.verdict == "pass";
+  AddStatistics(report, c);
+  c.histogram = report.histogram;
+  AddCharacteristics(report.characteristics, c);
+  AddDefects(report.defects, c);
   return c;
 }
 

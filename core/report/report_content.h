@@ -1,19 +1,19 @@
-// What a printed report shows, read from report.json (schema
-// "surfinspect.report/2", docs/inspection-plan.md) or from the errormap
-// command's report (no plan: the +-tolerance verdict, no tables): the
+// What a printed report shows, read from the typed report
+// (core/pipeline/inspection_report.h), with a plan or without one (then the
+// +-tolerance verdict and no tables): the
 // verdict, the statistics, the characteristics table with failed rows first,
 // the defects table and the histogram. Millimetres, part frame. Numbers are
 // formatted once here, so every renderer prints the same text.
 #pragma once
 
-#include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/errormap/defects.h"
 #include "core/errormap/error_map.h"
+#include "core/pipeline/inspection_report.h"
+#include "core/plan/defects.h"
 
 namespace surfinspect {
 
@@ -38,11 +38,9 @@ struct ReportContent {
 // A millimetre value as the report prints it: "%+.3f", "-" for null/NaN.
 std::string FormatMm(double v);
 
-// DataLoss naming the field when a required one (tolerance.band_mm,
-// tolerance.verdict unless there is a part verdict, color_range_mm) is
-// missing, or when a field that is present has the wrong type. Missing
-// points, statistics, histogram, characteristics or defects show as "-" or
-// empty.
-absl::StatusOr<ReportContent> ReportContentFromJson(const nlohmann::json& report);
+// DataLoss unless the report has its tolerance band and colour range (both
+// > 0). Missing counts, statistics, histogram, characteristics or defects
+// show as "-" or empty.
+absl::StatusOr<ReportContent> ReportContentFrom(const InspectionReport& report);
 
 }  // namespace surfinspect

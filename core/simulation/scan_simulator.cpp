@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/distance/embree_handles.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
@@ -126,15 +127,13 @@ double OntoDeformedSurface(const std::vector<SurfaceDefect>& defects, const Eige
 absl::StatusOr<std::vector<RayHit>> CastRays(const TriangleMesh& mesh_in_part,
                                              const Eigen::Isometry3d& part_from_sensor,
                                              const SensorIntrinsics& in, const ScanOptions& opt) {
-  auto device = EmbreeDevice::Create();
-  if (!device.ok()) return device.status();
-  auto scene = EmbreeTriangleScene::Build(*device, mesh_in_part);
-  if (!scene.ok()) return scene.status();
+  ASSIGN_OR_RETURN(auto device, EmbreeDevice::Create());
+  ASSIGN_OR_RETURN(auto scene, EmbreeTriangleScene::Build(device, mesh_in_part));
   const std::vector<Eigen::Vector3f> normals = mesh_in_part.FaceNormals();
   const Eigen::Vector3d origin = part_from_sensor.translation();
   const Pinhole camera(in);
   std::vector<RayHit> hits(std::size_t{in.width} * in.height);
-  RTCScene rtc_scene = (*scene)->get();
+  RTCScene rtc_scene = (scene)->get();
   tbb::parallel_for(tbb::blocked_range<uint32_t>(0, in.height), [&](const auto& rows) {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
@@ -169,7 +168,7 @@ absl::StatusOr<std::vector<RayHit>> CastRays(const TriangleMesh& mesh_in_part,
         h.range = t;
       }
   });
-  if (auto e = (*device)->TakeError(); !e.ok()) return e;
+  RETURN_IF_ERROR((device)->TakeError());
   return hits;
 }
 
@@ -280,16 +279,15 @@ absl::StatusOr<SimulatedScan> SimulateScan(const TriangleMesh& mesh_in_part,
                                            const Eigen::Isometry3d& world_from_sensor,
                                            const SensorIntrinsics& intrinsics,
                                            const ScanOptions& options) {
-  if (auto st = CheckScanInputs(intrinsics, options); !st.ok()) return st;
+  RETURN_IF_ERROR(CheckScanInputs(intrinsics, options));
   // Rays are cast in the part frame; results go back to the sensor frame.
   const Eigen::Isometry3d part_from_sensor = world_from_part.inverse() * world_from_sensor;
-  auto hits = CastRays(mesh_in_part, part_from_sensor, intrinsics, options);
-  if (!hits.ok()) return hits.status();
+  ASSIGN_OR_RETURN(auto hits, CastRays(mesh_in_part, part_from_sensor, intrinsics, options));
   SimulatedScan out;
   out.cloud_in_sensor = PointCloud::Organized(intrinsics.width, intrinsics.height);
   // Range along each pixel's ray, after stripes, pulses and noise.
-  std::vector<double> range = LabelHits(*hits, out);
-  if (options.stripes) AddStripes(*hits, intrinsics, options, range, out);
+  std::vector<double> range = LabelHits(hits, out);
+  if (options.stripes) AddStripes(hits, intrinsics, options, range, out);
   AddPulsesAndNoise(range, intrinsics, options, out);
   return out;
 }

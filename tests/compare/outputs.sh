@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # outputs.sh BIN OUT: the demo cell, then filter, calibrate, register, errormap (PLY, CSV, PNG, JSON)
-# and inspect (in-process and through a surfinspectd it starts), all written under OUT.
+# errormap with the cell's plan (every report file and the printed summary) and inspect
+# (in-process and through a surfinspectd it starts), all written under OUT.
 # A change keeps every output byte-identical when outputs.sh runs with the binaries from
 # before and after it and tests/compare/compare.sh BEFORE AFTER prints "identical".
 set -euo pipefail
@@ -29,6 +30,10 @@ args=(); for v in v1 v2 v3 v4 v5; do args+=(--scan $S/$v.pcd --world-from-sensor
   --csv errormap.csv --report errormap.json --png errormap.png --tolerance 0.3 >/dev/null
 "$si" errormap --cloud $S/v3.pcd --mesh cell/part.stl --out errormap_v3.ply --csv errormap_v3.csv \
   --png errormap_v3.png --max-distance 5 --threads 1 >/dev/null
+# With the cell's plan: the report's characteristics and defects, and every report file.
+"$si" errormap --cloud merged.ply --mesh cell/part.stl --world-from-part wfp.json --plan cell/plan.json \
+  --out planned.ply --report planned.json --png planned.png --pdf planned.pdf --html planned.html \
+  --qif planned.qif >planned.txt
 "$BIN/surfinspectd" --listen 127.0.0.1:0 >server.out 2>server.log &
 pid=$!; trap 'kill -9 $pid 2>/dev/null' EXIT
 for _ in $(seq 100); do grep -q "listening on" server.out 2>/dev/null && break; sleep 0.1; done

@@ -15,9 +15,9 @@ namespace fs = std::filesystem;
 namespace {
 
 // The stages, lowest first; core/CMakeLists.txt lists the same order.
-const std::vector<std::string> kStages = {"types",        "io",         "filter",    "distance",
-                                          "registration", "errormap",   "pipeline",  "report",
-                                          "history",      "acceptance", "simulation"};
+const std::vector<std::string> kStages = {"types",        "io",       "filter",     "distance",
+                                          "registration", "errormap", "plan",       "pipeline",
+                                          "report",       "history",  "acceptance", "simulation"};
 
 const fs::path kCore = fs::path(SURFINSPECT_SOURCE_DIR) / "core";
 const fs::path kTests = fs::path(SURFINSPECT_SOURCE_DIR) / "tests" / "core";

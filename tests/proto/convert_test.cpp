@@ -6,7 +6,7 @@
 #include <cstring>
 #include <string>
 
-#include "core/errormap/plan_report.h"
+#include "core/pipeline/inspection_report.h"
 
 namespace surfinspect::wire {
 namespace {

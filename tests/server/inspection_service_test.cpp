@@ -17,6 +17,7 @@
 #include "client/remote/remote_client.h"
 #include "core/io/mesh_hash.h"
 #include "core/pipeline/inspection.h"
+#include "core/pipeline/inspection_report.h"
 #include "core/registration/calibration.h"
 #include "core/simulation/demo_cell.h"
 #include "proto/convert.h"
@@ -165,7 +166,7 @@ TEST(InspectionService, ThePlanTravelsTypedAndTheResultsAreTypedToo) {
       *ComputeErrorMap(*part_index, d.merged_world, d.cell.world_from_part, {});
   const PlanOutcome outcome = *EvaluatePlan(map, d.merged_world, d.cell.part, plan);
   nlohmann::json remote = nlohmann::json::parse(eresp->report_json());
-  nlohmann::json local = InspectionReportJson(map, {}, outcome);
+  nlohmann::json local = EncodeReport(MakeInspectionReport(map, {}, outcome));
   remote.erase("timing");
   local.erase("timing");
   EXPECT_EQ(remote, local);

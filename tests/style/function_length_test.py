@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Functions fit on a screen: no function body in core/, server/, client/,
 proto/ or fuzz/ runs over 80 lines unless the line before it carries a
-comment starting `// long:` with the reason, and no core .cpp is over 300
-lines. Functions are found by their braces (a line ending in `{` after a
+comment starting `// long:` with the reason, and no .cpp in any of them is
+over 400 lines (one rule everywhere, so a class lives in one file). Functions are found by their braces (a line ending in `{` after a
 parameter list that is no control statement or lambda), which is what a
 reader sees. usage: function_length_test.py SOURCE_DIR
 """
@@ -11,7 +11,7 @@ import re
 import sys
 
 MAX_FUNCTION_LINES = 80
-MAX_CORE_FILE_LINES = 300
+MAX_FILE_LINES = 400
 FOLDERS = ("core", "server", "client", "proto", "fuzz")
 CONTROL = re.compile(r"^\s*(\}?\s*else|if|for|while|switch|do|catch|try)\b")
 TYPE_OR_SCOPE = re.compile(r"^\s*(namespace|extern|struct|class|enum|union)\b")
@@ -58,8 +58,8 @@ def main():
                 for line, length, text in long_functions(path):
                     failures.append(f"{rel}:{line}: a {length}-line function: {text[:70]}")
                 n = sum(1 for _ in open(path, encoding="utf-8"))
-                if folder == "core" and name.endswith(".cpp") and n > MAX_CORE_FILE_LINES:
-                    failures.append(f"{rel}: {n} lines (a core .cpp holds one algorithm, <= 300)")
+                if name.endswith(".cpp") and n > MAX_FILE_LINES:
+                    failures.append(f"{rel}: {n} lines (a .cpp holds one concern, <= 400)")
     for f in failures:
         print("FAIL", f)
     print(f"{files} files read")

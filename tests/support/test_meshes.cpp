@@ -1,5 +1,7 @@
 #include "tests/support/test_meshes.h"
 
+#include <gtest/gtest.h>
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -130,6 +132,16 @@ double MeshHeightAt(const TriangleMesh& mesh, double x, double y) {
       return a.z() + s * (b.z() - a.z()) + r * (c.z() - a.z());
   }
   return NAN;
+}
+
+TriangleMesh FlatSquare() {
+  return HeightField(0, 100, 0, 100, 11, 11, [](double, double) { return 0.0; });
+}
+
+std::unique_ptr<MeshIndex> IndexOf(const TriangleMesh& mesh) {
+  auto index = MeshIndex::Build(mesh);
+  EXPECT_TRUE(index.ok()) << index.status();
+  return index.ok() ? *std::move(index) : nullptr;
 }
 
 }  // namespace surfinspect::testing

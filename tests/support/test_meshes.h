@@ -4,7 +4,9 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <memory>
 
+#include "core/distance/mesh_index.h"
 #include "core/types/triangle_mesh.h"
 
 namespace surfinspect::testing {
@@ -20,6 +22,12 @@ TriangleMesh Box(const Eigen::Vector3d& min, const Eigen::Vector3d& max);
 // diagonal.
 TriangleMesh HeightField(double x0, double x1, double y0, double y1, int nx, int ny,
                          const std::function<double(double, double)>& f);
+
+// The plane z = 0 over [0, 100]^2 mm on an 11 x 11 grid, normals up.
+TriangleMesh FlatSquare();
+
+// The mesh's index; a failed build fails the test and gives null.
+std::unique_ptr<MeshIndex> IndexOf(const TriangleMesh& mesh);
 
 // Generalised winding number of a closed mesh at p (sum of the triangles'
 // signed solid angles / 4 pi; Van Oosterom & Strackee 1983): ~1 inside,

@@ -100,11 +100,26 @@ TEST_F(AgentTest, UnavailableTwiceThenOkIsDoneAfterThreeCalls) {
   EXPECT_EQ(r.verdict, "pass");
   EXPECT_DOUBLE_EQ(r.max_mm, 0.25);
   EXPECT_DOUBLE_EQ(r.min_mm, -0.125);
-  for (const char* f :
-       {"report.json", "report.html", "errormap.ply", "errormap.png", "deviations.csv"})
-    EXPECT_TRUE(fs::exists(fs::path(layout_.results) / "p1" / f)) << f;
+  // The cell's outputs (the defaults: all but the CSV), and no other file;
+  // the fake server's report has no plan, so no result.qif.
+  for (const PartFileEntry& e : PartFileCatalogue())
+    EXPECT_EQ(fs::exists(fs::path(layout_.results) / "p1" / e.file_name),
+              cell_.outputs.Has(e.file) && e.file != PartFile::kQif)
+        << e.file_name;
   EXPECT_FALSE(InInbox("p1"));
   EXPECT_TRUE(fs::exists(fs::path(layout_.archive) / "p1" / "v1.pcd"));
+}
+
+TEST_F(AgentTest, ThePartGetsTheFilesTheCellsOutputsName) {
+  cell_.outputs = PartFileSet::All();
+  cell_.outputs.Set(PartFile::kPdf, false);
+  DropPart("p1");
+  CellAgent agent = Agent();
+  ASSERT_EQ(agent.ProcessPart("p1", stop_).outcome, PartOutcome::kDone);
+  for (const PartFileEntry& e : PartFileCatalogue())
+    EXPECT_EQ(fs::exists(fs::path(layout_.results) / "p1" / e.file_name),
+              e.file != PartFile::kPdf && e.file != PartFile::kQif)
+        << e.file_name;
 }
 
 TEST_F(AgentTest, ReportHtmlCarriesTheCellAndTheMeshReadOnce) {

@@ -1,6 +1,6 @@
 // client/agent/mqtt_events.cpp: URLs, the settings' validator, cell.json's
 // "mqtt" block, topics and payloads (against the report they summarise).
-// The publisher against a real broker is tests/agent/mqtt_e2e_test.py.
+// The publisher against a real broker is tests/client/agent/mqtt_e2e_test.py.
 #include "client/agent/mqtt_events.h"
 
 #include <gtest/gtest.h>
@@ -106,14 +106,21 @@ TEST(MqttTopics, PrefixCellPartEvent) {
 
 TEST(MqttPayloads, ResultSummarisesTheReport) {
   testing::TempDir dir;
-  const json report = {
-      {"schema", "surfinspect.report/2"},
-      {"verdict", "fail"},
-      {"statistics", {{"min_mm", -0.4}, {"max_mm", 0.2}}},
-      {"characteristics",
-       {{{"name", "surface"}, {"type", "surface"}, {"verdict", "pass"}, {"reason", "ok"}},
-        {{"name", "ridge"}, {"type", "region"}, {"verdict", "fail"}, {"reason", "too high"}}}},
-      {"defects", json::array({json::object(), json::object()})}};
+  const json report = {{"schema", "surfinspect.report/2"},
+                       {"verdict", "fail"},
+                       {"statistics", {{"min_mm", -0.4}, {"max_mm", 0.2}}},
+                       {"characteristics",
+                        {{{"name", "surface"},
+                          {"type", "surface"},
+                          {"verdict", "pass"},
+                          {"reason", "ok"},
+                          {"tolerance_mm", {{"lower", -0.3}, {"upper", 0.3}}}},
+                         {{"name", "ridge"},
+                          {"type", "region"},
+                          {"verdict", "fail"},
+                          {"reason", "too high"},
+                          {"tolerance_mm", {{"lower", -0.15}, {"upper", 0.15}}}}}},
+                       {"defects", json::array({{{"id", 1}}, {{"id", 2}}})}};
   std::ofstream(dir.File("report.json")) << report.dump();
   std::ofstream(dir.File("result.qif")) << "<QIFDocument/>";
   auto text = ResultPayload("cell-a", "p-1", dir.path(), report.dump(), "2026-12-01T10:00:00.000Z");

@@ -43,6 +43,25 @@ TEST(CellConfig, ReadsTheSettingsBlocks) {
   EXPECT_EQ(c->filter_settings.connectivity, 4);
 }
 
+// "outputs" names the files each part gets, by catalogue name; an unknown
+// name is refused by name before any part is taken.
+TEST(CellConfig, OutputsAreCatalogueNamesAndTheDefaultLeavesOutTheCsv) {
+  auto plain = Read(Cell(""));
+  ASSERT_TRUE(plain.ok()) << plain.status();
+  EXPECT_EQ(plain->outputs.Names(), PartFileSet::Defaults().Names());
+  EXPECT_FALSE(plain->outputs.Has(PartFile::kCsv));
+  auto some = Read(Cell(R"(, "outputs": ["csv", "pdf"])"));
+  ASSERT_TRUE(some.ok()) << some.status();
+  EXPECT_EQ(some->outputs.Names(), "report, csv, pdf");
+  auto unknown = Read(Cell(R"(, "outputs": ["ply", "stl"])"));
+  EXPECT_EQ(unknown.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(unknown.status().message().find("cell.json"), std::string::npos) << unknown.status();
+  EXPECT_NE(unknown.status().message().find("unknown output \"stl\""), std::string::npos)
+      << unknown.status();
+  EXPECT_FALSE(Read(Cell(R"(, "outputs": "ply")")).ok());
+  EXPECT_FALSE(Read(Cell(R"(, "outputs": [1])")).ok());
+}
+
 // The cell's name goes into results, topics and the store: it defaults to the
 // folder's name and is refused, by name, when it could break a path or topic.
 TEST(CellConfig, NameDefaultsToTheFolderAndIsCheckedForSafeCharacters) {

@@ -8,9 +8,9 @@
 #include <filesystem>
 #include <random>
 
-#include "core/errormap/error_map_output.h"
 #include "core/history/triangle_summary.h"
 #include "core/io/atomic_file.h"
+#include "core/report/error_map_output.h"
 #include "tests/support/temp_dir.h"
 #include "tests/support/test_meshes.h"
 

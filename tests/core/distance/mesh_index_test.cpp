@@ -21,12 +21,6 @@ namespace {
 using Eigen::Vector3d;
 using testing::DistanceByProjection;
 
-std::unique_ptr<MeshIndex> BuildOrDie(const TriangleMesh& mesh) {
-  auto index = MeshIndex::Build(mesh);
-  EXPECT_TRUE(index.ok()) << index.status();
-  return index.ok() ? *std::move(index) : nullptr;
-}
-
 Vector3d V(const TriangleMesh& m, uint32_t i) { return m.vertices[i].cast<double>(); }
 
 // Brute force over every triangle with the same kernel: the lexicographic
@@ -269,7 +263,7 @@ TEST(MeshIndex, SignAgreesWithTheWindingNumberOnClosedMeshes) {
   int checked = 0;
   for (std::size_t k = 0; k < meshes.size(); ++k) {
     const TriangleMesh& m = meshes[k].first;
-    auto index = BuildOrDie(m);
+    auto index = testing::IndexOf(m);
     ASSERT_TRUE(index);
     EXPECT_EQ(index->info().boundary_edges, 0u);
     for (const Vector3d& p : SignQueryPoints(m, 100 + k, meshes[k].second)) {
@@ -288,7 +282,7 @@ TEST(MeshIndex, SignOnAnOpenSheetIsTheFaceSide) {
   const TriangleMesh sheet = testing::HeightField(0, 60, 0, 40, 61, 41, [](double x, double y) {
     return 2 * std::sin(x / 7) * std::cos(y / 5) + 0.05 * x;
   });
-  auto index = BuildOrDie(sheet);
+  auto index = testing::IndexOf(sheet);
   ASSERT_TRUE(index);
   EXPECT_GT(index->info().boundary_edges, 0u);
   int checked = 0;
@@ -362,7 +356,7 @@ TEST(MeshIndex, SignIsRightAtSharpSheetMetalFolds) {
   int checked = 0;
   for (const Fold& fold : folds) {
     const TriangleMesh m = Extrude(fold.profile);
-    auto index = BuildOrDie(m);
+    auto index = testing::IndexOf(m);
     ASSERT_TRUE(index);
     std::vector<P> polygon = fold.profile;
     polygon.insert(polygon.end(), fold.closure.begin(), fold.closure.end());
@@ -399,13 +393,13 @@ TEST(MeshIndex, VertexPseudonormalsMadeOnFirstUseAgreeAcrossThreads) {
   const PointCloud cloud = PointCloud::Unorganized(std::move(pts));
   std::vector<double> want;
   for (const Eigen::Vector3f& p : cloud.points) {
-    const ClosestPoint r = BuildOrDie(m)->Closest(p.cast<double>());
+    const ClosestPoint r = testing::IndexOf(m)->Closest(p.cast<double>());
     want.push_back(r.signed_distance_mm);
     if (want.size() == 200) break;  // a fresh index per point: the serial oracle
   }
   int at_vertex = 0;
   for (int threads : {1, 2, 8}) {
-    auto index = BuildOrDie(m);
+    auto index = testing::IndexOf(m);
     ASSERT_TRUE(index);
     BatchQuerySettings s;
     s.threads = threads;
@@ -426,7 +420,7 @@ TEST(MeshIndex, PyramidApexAndPitUseTheVertexPseudonormal) {
       const TriangleMesh m = testing::HeightField(
           -10, 10, -10, 10, 21, 21,
           [&](double x, double y) { return s * k * std::max(std::abs(x), std::abs(y)); });
-      auto index = BuildOrDie(m);
+      auto index = testing::IndexOf(m);
       ASSERT_TRUE(index);
       std::mt19937_64 rng(static_cast<uint64_t>(k * 10 + s));
       std::normal_distribution<double> g;
@@ -478,7 +472,7 @@ TEST(MeshIndex, SignIsRightAtRandomFanVertices) {
       all.triangles.push_back({base + t[0], base + t[1], base + t[2]});
     fans.push_back(std::move(fan));
   }
-  auto index = BuildOrDie(all);
+  auto index = testing::IndexOf(all);
   ASSERT_TRUE(index);
   int checked = 0, at_vertex = 0;
   for (const TriangleMesh& fan : fans) {
@@ -508,7 +502,7 @@ TEST(MeshIndex, UnweldedSoupStillSignsByTopology) {
     for (uint32_t v : t) soup.vertices.push_back(welded.vertices[v]);
     soup.triangles.push_back({b, b + 1, b + 2});
   }
-  auto index = BuildOrDie(soup);
+  auto index = testing::IndexOf(soup);
   ASSERT_TRUE(index);
   EXPECT_EQ(index->info().welded_vertices, 36u - 8u);
   EXPECT_EQ(index->info().boundary_edges, 0u);
@@ -532,7 +526,7 @@ TEST(MeshIndex, DegenerateAndNonManifoldTrianglesDoNotBreakQueries) {
   m.triangles.push_back({0, 1, 2});    // a collinear sliver along y = 0
   m.triangles.push_back({n, n, n});    // a point
   m.triangles.push_back({12, 13, n});  // shares edge 12-13: now non-manifold
-  auto index = BuildOrDie(m);
+  auto index = testing::IndexOf(m);
   ASSERT_TRUE(index);
   EXPECT_EQ(index->info().degenerate_triangles, 2u);
   EXPECT_GE(index->info().nonmanifold_edges, 1u);
@@ -564,7 +558,7 @@ TEST(MeshIndex, TopologyAndDegenerateCountAreTheMeshCounts) {
     soup.triangles.push_back({b, b + 1, b + 2});
   }
   for (const TriangleMesh* mesh : {&m, &soup}) {
-    auto index = BuildOrDie(*mesh);
+    auto index = testing::IndexOf(*mesh);
     ASSERT_TRUE(index);
     const MeshTopology want = AnalyzeTopology(*mesh);
     EXPECT_EQ(index->Topology().boundary_edges, want.boundary_edges);
@@ -594,7 +588,7 @@ TEST(MeshIndex, BuildRejectsBadMeshesAndSettings) {
 }
 
 TEST(MeshIndex, MaxDistanceNonFinitePointsAndMemory) {
-  auto index = BuildOrDie(testing::Box(Vector3d::Zero(), Vector3d::Constant(10)));
+  auto index = testing::IndexOf(testing::Box(Vector3d::Zero(), Vector3d::Constant(10)));
   ASSERT_TRUE(index);
   EXPECT_TRUE(index->Closest(Vector3d(5, 5, 12), 2.5).matched());
   EXPECT_NEAR(index->Closest(Vector3d(5, 5, 12), 2.5).signed_distance_mm, 2.0, 1e-12);
@@ -641,7 +635,7 @@ void ExpectIdentical(const std::vector<ClosestPoint>& a, const std::vector<Close
 TEST(MeshIndexBatch, OneAndManyThreadsAndCoherentStartGiveIdenticalResults) {
   const TriangleMesh sheet = testing::HeightField(
       0, 30, 0, 20, 31, 21, [](double x, double y) { return std::sin(x / 4) * std::cos(y / 3); });
-  auto index = BuildOrDie(sheet);
+  auto index = testing::IndexOf(sheet);
   ASSERT_TRUE(index);
   const PointCloud organized = OrganizedCloudNear(sheet, 60, 40, 1);
   // Unorganized: the same points shuffled (exercises the Morton order).
@@ -716,7 +710,7 @@ TEST(MeshIndex, TheSearchIsaIsReportedAndAnUnsupportedOneRejected) {
 }
 
 TEST(MeshIndexBatch, CancelAndBadInput) {
-  auto index = BuildOrDie(testing::Box(Vector3d::Zero(), Vector3d::Constant(10)));
+  auto index = testing::IndexOf(testing::Box(Vector3d::Zero(), Vector3d::Constant(10)));
   ASSERT_TRUE(index);
   PointCloud cloud =
       PointCloud::Unorganized(std::vector<Eigen::Vector3f>(5000, Eigen::Vector3f(1, 2, 3)));
@@ -751,7 +745,7 @@ TEST(MeshIndexBatch, CancelAndBadInput) {
 TEST(MeshIndexBatch, QueryClosestEachCallsTheSinkOnceForEveryIndex) {
   const TriangleMesh sheet = testing::HeightField(
       0, 30, 0, 20, 31, 21, [](double x, double y) { return 0.5 * std::sin(x / 5) + 0.1 * y; });
-  auto index = BuildOrDie(sheet);
+  auto index = testing::IndexOf(sheet);
   ASSERT_TRUE(index);
   PointCloud cloud = OrganizedCloudNear(sheet, 50, 30, 3);
   for (std::size_t i = 0; i < cloud.size(); i += 11)

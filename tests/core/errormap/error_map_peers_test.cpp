@@ -1,4 +1,4 @@
-// The error-map PLY of core/errormap/error_map_output.cpp as its peers load
+// The error-map PLY of core/report/error_map_output.cpp as its peers load
 // it: Debian's CloudCompare in command-line mode (a real run), and the
 // property rules of MeshLab's PLY importer (vcglib wrap/io_trimesh/
 // import_ply.h: vertex "x" "y" "z" float, "quality" float, "red" "green"
@@ -13,8 +13,8 @@
 #include <map>
 #include <sstream>
 
-#include "core/errormap/error_map_output.h"
 #include "core/io/io_point_cloud.h"
+#include "core/report/error_map_output.h"
 #include "tests/support/temp_dir.h"
 
 namespace surfinspect {

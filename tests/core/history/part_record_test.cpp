@@ -8,7 +8,9 @@ namespace surfinspect {
 namespace {
 
 TEST(PartRecord, FromReport) {
-  const std::string report = R"({"verdict": "fail", "defects": [{"id": 1}],
+  const std::string defects =
+      R"([{"area_mm2":12.5,"centroid_mm":[1.5,-2.0,60.0],"extent_mm":4.0,"id":1,"kind":"dent","peak_mm":-0.25,"points":180,"region":"ridge"}])";
+  const std::string report = R"({"verdict": "fail", "defects": )" + defects + R"(,
     "characteristics": [
       {"name": "surface", "type": "surface", "verdict": "pass", "mean_mm": 0.01, "min_mm": -0.2,
        "max_mm": 0.3, "stddev_mm": 0.02, "points": 1000,
@@ -26,7 +28,7 @@ TEST(PartRecord, FromReport) {
   EXPECT_EQ(r.characteristics[1].lower_mm, -0.1);
   EXPECT_EQ(r.characteristics[0].points, 1000);
   EXPECT_TRUE(std::isnan(r.characteristics[2].value_mm));
-  EXPECT_EQ(r.defects_json, R"([{"id":1}])");
+  EXPECT_EQ(r.defects_json, defects);
 }
 
 TEST(PartRecord, BadReportsAreNamed) {

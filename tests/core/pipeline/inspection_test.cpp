@@ -10,8 +10,8 @@
 #include <nlohmann/json.hpp>
 #include <tuple>
 
-#include "core/errormap/error_map_output.h"
-#include "core/errormap/error_map_png.h"
+#include "core/pipeline/inspection_report.h"
+#include "core/report/error_map_png.h"
 #include "core/simulation/demo_cell.h"
 #include "core/simulation/scan_simulator.h"
 #include "core/types/transform.h"
@@ -315,7 +315,7 @@ TEST_F(Inspection, ReportTextIsTheErrorMapJsonIndentedWithANewline) {
   EXPECT_EQ(text.back(), '\n');
   EXPECT_EQ(text.substr(0, 5), "{\n  \"") << "two-space indentation";
   const nlohmann::json parsed = nlohmann::json::parse(text);
-  EXPECT_EQ(parsed, InspectionReportJson(result_->error_map, es, result_->plan));
+  EXPECT_EQ(parsed, EncodeReport(MakeInspectionReport(result_->error_map, es, result_->plan)));
   EXPECT_EQ(parsed["points"]["matched"], result_->error_map.stats.matched);
   EXPECT_EQ(parsed["tolerance"]["verdict"], "fail");
 }

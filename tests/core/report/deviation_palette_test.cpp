@@ -5,7 +5,7 @@
 #include <cmath>
 #include <random>
 
-#include "core/errormap/error_map_output.h"
+#include "core/errormap/deviation_color.h"
 
 namespace surfinspect {
 namespace {

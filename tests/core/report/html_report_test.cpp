@@ -7,6 +7,7 @@
 
 #include <regex>
 
+#include "core/pipeline/inspection_report.h"
 #include "core/report/html_escape.h"
 #include "core/report/html_histogram.h"
 #include "tests/support/temp_dir.h"
@@ -79,9 +80,17 @@ std::string ScriptText(const std::string& html, const std::string& id) {
   return html.substr(begin + open.size(), end - begin - open.size());
 }
 
-absl::StatusOr<HtmlReportPage> Page(const json& report, const Points& p,
+// The typed report of a report.json object (the decoding must succeed).
+InspectionReport Typed(const json& j) {
+  absl::StatusOr<InspectionReport> r = DecodeReport(j);
+  EXPECT_TRUE(r.ok()) << r.status();
+  return r.ok() ? *std::move(r) : InspectionReport{};
+}
+
+absl::StatusOr<HtmlReportPage> Page(const json& report_json, const Points& p,
                                     const std::string& part_id = "part-1",
                                     std::size_t max_points = 1'000'000) {
+  const InspectionReport report = Typed(report_json);
   HtmlReportInput in;
   in.report = &report;
   in.points_in_part = &p.cloud;
@@ -166,7 +175,7 @@ TEST(HtmlReport, PanelsFailedFirstDefectsCalibrationHistogram) {
 }
 
 TEST(HtmlHistogram, LogAxisKeepsSmallBinsVisible) {
-  const std::string svg = HistogramSvg(Report(), MakeDeviationPalette(0.3, 1.0));
+  const std::string svg = HistogramSvg(Typed(Report()).histogram, MakeDeviationPalette(0.3, 1.0));
   // The bin with 1 count is log10(2) / log10(1e6 + 1) ~ 5% of the tallest, not 1e-6.
   const std::regex bar(R"re(<rect x="[0-9.]+" y="[0-9.]+" width="[0-9.]+" height="([0-9.]+)")re");
   std::vector<double> heights;
@@ -186,14 +195,18 @@ TEST(HtmlReport, RefusesIncompleteInput) {
   EXPECT_EQ(Page(no_band, p).status().code(), absl::StatusCode::kInvalidArgument);
   HtmlReportInput in;
   EXPECT_EQ(BuildHtmlReport(in).status().code(), absl::StatusCode::kInvalidArgument);
-  // Fields of unexpected types are shown as they are or left out, never a crash.
+  // Fields of unexpected types are refused when the report is decoded, never
+  // a crash; a report without a histogram is drawn without one.
   json odd = Report();
   odd["verdict"] = 3;
   odd["histogram"] = "none";
   odd["defects"] = {1, "two", nullptr};
   odd["characteristics"] = 5;
   odd["statistics"] = nullptr;
-  auto page = Page(odd, p);
+  EXPECT_EQ(DecodeReport(odd).status().code(), absl::StatusCode::kDataLoss);
+  json no_histogram = Report();
+  no_histogram.erase("histogram");
+  auto page = Page(no_histogram, p);
   ASSERT_TRUE(page.ok()) << page.status();
   EXPECT_NE(page->html.find("no histogram"), std::string::npos);
 }
@@ -201,7 +214,7 @@ TEST(HtmlReport, RefusesIncompleteInput) {
 TEST(HtmlReport, WritesTheFile) {
   testing::TempDir dir;
   const Points p = SomePoints(10);
-  const json report = Report();
+  const InspectionReport report = Typed(Report());
   HtmlReportInput in;
   in.report = &report;
   in.points_in_part = &p.cloud;

@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/pipeline/inspection_report.h"
 #include "core/report/pdf_canvas.h"
 #include "tests/support/png_decode.h"
 #include "tests/support/temp_dir.h"
@@ -48,7 +49,7 @@ int Pages(const std::string& info) {
   return at == std::string::npos ? -1 : std::atoi(info.c_str() + at + 6);
 }
 
-nlohmann::json Report(const std::string& name) {
+InspectionReport Report(const std::string& name) {
   nlohmann::json j = nlohmann::json::parse(R"({
     "verdict": "fail",
     "tolerance": {"band_mm": 0.1, "verdict": "fail", "reason": "2 points outside", "fraction_within": 0.5},
@@ -62,7 +63,9 @@ nlohmann::json Report(const std::string& name) {
                  "extent_mm": 1, "peak_mm": 0.45, "points": 5}]})");
   j["characteristics"][0]["name"] = name;
   j["defects"][0]["region"] = name;
-  return j;
+  absl::StatusOr<InspectionReport> report = DecodeReport(j);
+  EXPECT_TRUE(report.ok()) << report.status();
+  return report.ok() ? *std::move(report) : InspectionReport{};
 }
 
 // A 20 x 10 organized cloud, deviation -0.5 .. +0.45 mm by column.
@@ -91,7 +94,7 @@ Cloud MakeCloud(bool organized) {
 TEST(PdfReport, ForeignStringsRenderLiterallyOnAnA4PageWithEmbeddedFonts) {
   if (!HavePoppler()) GTEST_SKIP() << "poppler-utils (pdftotext) not installed: PDF NOT CHECKED";
   const Cloud c = MakeCloud(true);
-  const nlohmann::json report = Report(kNasty);
+  const InspectionReport report = Report(kNasty);
   PdfReportInput in;
   in.part_id = std::string("part \"1\" <i>&amp;</i> '") + kNasty;
   in.cell = "cell <7>";
@@ -136,7 +139,7 @@ TEST(PdfReport, RenderedMapAreaIsNotBlank) {
   if (!HavePoppler()) GTEST_SKIP() << "poppler-utils (pdftoppm) not installed: PDF NOT CHECKED";
   for (bool organized : {true, false}) {
     const Cloud c = MakeCloud(organized);
-    const nlohmann::json report = Report("top");
+    const InspectionReport report = Report("top");
     PdfReportInput in;
     in.part_id = "p1";
     in.report = &report;
@@ -174,7 +177,7 @@ TEST(PdfReport, RenderedMapAreaIsNotBlank) {
 
 TEST(PdfReport, BadInputsAreErrorsNotCrashes) {
   const Cloud c = MakeCloud(true);
-  const nlohmann::json report = Report("r");
+  const InspectionReport report = Report("r");
   PdfReportInput in;
   EXPECT_EQ(RenderPdfReport(in).status().code(), absl::StatusCode::kInvalidArgument);
   in.report = &report;
@@ -183,7 +186,7 @@ TEST(PdfReport, BadInputsAreErrorsNotCrashes) {
   in.deviation_mm = &short_dev;
   EXPECT_EQ(RenderPdfReport(in).status().code(), absl::StatusCode::kInvalidArgument);
   in.deviation_mm = &c.deviation;
-  const nlohmann::json empty = nlohmann::json::object();
+  const InspectionReport empty;  // no tolerance band, no colour range
   in.report = &empty;
   EXPECT_EQ(RenderPdfReport(in).status().code(), absl::StatusCode::kDataLoss);
   in.report = &report;
@@ -205,11 +208,11 @@ TEST(PdfReport, BadInputsAreErrorsNotCrashes) {
 TEST(PdfReport, LongTablesContinueOnMorePages) {
   if (!HavePoppler()) GTEST_SKIP() << "poppler-utils not installed: PDF NOT CHECKED";
   const Cloud c = MakeCloud(true);
-  nlohmann::json report = Report("r");
+  InspectionReport report = Report("r");
   for (int i = 0; i < 120; ++i) {
-    nlohmann::json ch = report["characteristics"][0];
-    ch["name"] = "row-" + std::to_string(i);
-    report["characteristics"].push_back(ch);
+    ReportCharacteristic ch = report.characteristics[0];
+    ch.name = "row-" + std::to_string(i);
+    report.characteristics.push_back(ch);
   }
   PdfReportInput in;
   in.part_id = "p";

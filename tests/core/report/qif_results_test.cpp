@@ -13,6 +13,8 @@
 #include <pugixml.hpp>
 #include <string>
 
+#include "core/pipeline/inspection_report.h"
+#include "core/types/status_macros.h"
 #include "tests/support/temp_dir.h"
 
 namespace surfinspect {
@@ -44,6 +46,12 @@ json Report() {
   return r;
 }
 
+// The QIF of a report.json text, as a part's files are made: parsed, then mapped.
+absl::StatusOr<std::string> XmlOf(const std::string& report_json, const QifContext& context) {
+  ASSIGN_OR_RETURN(InspectionReport report, ParseReport(report_json));
+  return QifResultsXml(report, context);
+}
+
 QifContext Context() {
   QifContext c;
   c.part_id = "part-0007";
@@ -60,7 +68,7 @@ pugi::xml_node ById(const pugi::xml_document& doc, const std::string& id) {
 
 TEST(QifResults, EveryCharacteristicReadsBackAsTheReportSays) {
   const json report = Report();
-  auto xml = QifResultsXml(report.dump(), Context());
+  auto xml = XmlOf(report.dump(), Context());
   ASSERT_TRUE(xml.ok()) << xml.status();
   pugi::xml_document doc;
   ASSERT_TRUE(doc.load_string(xml->c_str()));
@@ -113,13 +121,13 @@ TEST(QifResults, EveryCharacteristicReadsBackAsTheReportSays) {
 }
 
 TEST(QifResults, SameInputGivesTheSameBytesAndStableCharacteristicUuids) {
-  auto a = QifResultsXml(Report().dump(), Context());
-  auto b = QifResultsXml(Report().dump(), Context());
+  auto a = XmlOf(Report().dump(), Context());
+  auto b = XmlOf(Report().dump(), Context());
   ASSERT_TRUE(a.ok() && b.ok());
   EXPECT_EQ(*a, *b);
   QifContext other = Context();
   other.part_id = "part-0008";
-  auto c = QifResultsXml(Report().dump(), other);
+  auto c = XmlOf(Report().dump(), other);
   ASSERT_TRUE(c.ok());
   pugi::xml_document da, dc;
   ASSERT_TRUE(da.load_string(a->c_str()) && dc.load_string(c->c_str()));
@@ -137,20 +145,17 @@ TEST(QifResults, UuidIsRfc4122Version5) {
 }
 
 TEST(QifResults, BadInputIsNamed) {
-  EXPECT_NE(QifResultsXml("not json", Context()).status().message().find("JSON"),
-            std::string::npos);
+  EXPECT_NE(XmlOf("not json", Context()).status().message().find("JSON"), std::string::npos);
   json r = Report();
   r["schema"] = "surfinspect.report/1";
-  EXPECT_NE(QifResultsXml(r.dump(), Context()).status().message().find("schema"),
-            std::string::npos);
+  EXPECT_NE(XmlOf(r.dump(), Context()).status().message().find("schema"), std::string::npos);
   r = Report();
   r["characteristics"][1].erase("tolerance_mm");
-  EXPECT_NE(QifResultsXml(r.dump(), Context()).status().message().find("characteristics[1]"),
+  EXPECT_NE(XmlOf(r.dump(), Context()).status().message().find("characteristics[1]"),
             std::string::npos);
   QifContext no_part = Context();
   no_part.part_id.clear();
-  EXPECT_EQ(QifResultsXml(Report().dump(), no_part).status().code(),
-            absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(XmlOf(Report().dump(), no_part).status().code(), absl::StatusCode::kInvalidArgument);
 }
 
 TEST(QifResults, ValidatesAgainstTheQif3Schema) {
@@ -165,7 +170,7 @@ TEST(QifResults, ValidatesAgainstTheQif3Schema) {
   only_surface["verdict"] = "pass";
   for (const json& report : {Report(), only_surface}) {
     const std::string path = dir.path() + "/r.qif";
-    ASSERT_TRUE(WriteQifResults(path, report.dump(), Context()).ok());
+    ASSERT_TRUE(WriteQifResults(path, *ParseReport(report.dump()), Context()).ok());
     const std::string cmd =
         "xmllint --noout --nonet --schema '" + xsd.string() + "' '" + path + "' 2>&1";
     EXPECT_EQ(std::system(cmd.c_str()), 0) << report.dump();

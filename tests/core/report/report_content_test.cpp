@@ -1,11 +1,20 @@
 // core/report/report_content.cpp: what the printed report shows, read from
-// the report JSON.
+// the typed report.
 #include "core/report/report_content.h"
 
 #include <gtest/gtest.h>
 
+#include "core/pipeline/inspection_report.h"
+#include "core/types/status_macros.h"
+
 namespace surfinspect {
 namespace {
+
+// What the printed report shows of a report.json object: decoded, then read.
+absl::StatusOr<ReportContent> ReportContentFromJson(const nlohmann::json& j) {
+  ASSIGN_OR_RETURN(InspectionReport report, DecodeReport(j));
+  return ReportContentFrom(report);
+}
 
 nlohmann::json Report() {
   return nlohmann::json::parse(R"({

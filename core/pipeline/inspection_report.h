@@ -1,0 +1,151 @@
+// report.json ("schema": "surfinspect.report/2") as a type with one JSON
+// codec. Every program writes the report through EncodeReport, so the CLI,
+// the server and the cell-agent write the same bytes; every reader (the PDF
+// and HTML reports, QIF, the results store, the CLI's summary, MQTT events)
+// decodes it with DecodeReport and reads the struct, never a JSON key.
+// docs/reports.md lists the fields.
+//
+// Millimetres, part frame. A number that does not exist (a statistic over
+// no points, a comparison point with no point near it) is NaN here and null
+// in the JSON; a decoded report that lacks a section has that section's
+// defaults (NaN, 0, empty).
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/errormap/error_map.h"
+#include "core/plan/characteristics.h"
+#include "core/plan/defects.h"
+#include "core/plan/plan_evaluation.h"
+#include "core/types/json_fields.h"
+
+namespace surfinspect {
+
+inline constexpr char kReportSchema[] = "surfinspect.report/2";
+
+// The error-map settings the report was made with.
+struct ReportSettings {
+  double tolerance_mm = 0;
+  double max_distance_mm = NAN;  // NaN (null): unlimited
+  double allowed_fraction_outside = 0;
+  int histogram_bins = 0;
+  bool split_components = false;
+};
+
+// The +-band verdict over all matched points.
+struct ReportTolerance {
+  double band_mm = 0;
+  std::size_t within = 0, above = 0, below = 0;
+  double fraction_within = NAN, fraction_outside = NAN;  // of matched points
+  std::string verdict;                                   // "pass" | "fail"; "" when not said
+  std::string reason;                                    // one line, for people
+};
+
+// One characteristic of the plan, as judged.
+struct ReportCharacteristic {
+  std::string name;
+  std::string type;                   // "surface" | "region" | "point"
+  std::string verdict;                // "pass" | "fail"
+  std::string reason;                 // one line, for people
+  ToleranceBand tolerance{NAN, NAN};  // NaN when not said
+  std::size_t points = 0;             // matched points judged
+  double min_mm = NAN, max_mm = NAN, mean_mm = NAN, stddev_mm = NAN, rms_mm = NAN;
+  double fraction_within = NAN;
+  double value_mm = NAN;                  // points only
+  double allowed_fraction_outside = NAN;  // surface and regions only
+  bool is_point() const { return type == "point"; }
+  bool passed() const { return verdict == "pass"; }
+  bool operator==(const ReportCharacteristic& o) const;
+};
+
+// One defect found by the plan's defect rules.
+struct ReportDefect {
+  int id = 0;
+  std::string kind;  // "dent" | "bump"
+  Eigen::Vector3d centroid_mm = Eigen::Vector3d::Zero();
+  double area_mm2 = 0, extent_mm = 0, peak_mm = 0;
+  std::size_t points = 0;
+  std::string region;  // "" outside every region
+  bool operator==(const ReportDefect& o) const;
+};
+
+// Timing of the distances, and of the whole command where the program that
+// wrote the report timed it (the CLI's errormap).
+struct ReportTiming {
+  double query_seconds = 0, order_seconds = 0, statistics_seconds = 0;
+  std::size_t certified_points = 0, hint_alone_points = 0;
+  std::optional<double> read_seconds, build_seconds, plan_seconds, png_seconds, write_seconds,
+      total_seconds;
+};
+
+// The CAD mesh's summary, where the program that wrote the report made one.
+struct ReportMesh {
+  std::size_t triangles = 0, boundary_edges = 0, nonmanifold_edges = 0, degenerate_triangles = 0;
+};
+
+// The input files, where the program that wrote the report read files.
+struct ReportInputs {
+  std::string cloud, mesh, world_from_part;
+};
+
+struct InspectionReport {
+  std::string schema = kReportSchema;  // "" for an error-map report without a plan
+  std::string verdict;                 // the part verdict; "" without a plan
+  ReportSettings settings;
+  ErrorMapStats stats;  // point counts and the statistics of all matched points
+  ReportTolerance tolerance;
+  Histogram histogram;
+  double color_range_mm = 0;
+  std::optional<std::array<ComponentStats, 4>> components;  // x, y, z, normal; part frame
+  ReportTiming timing;
+  std::vector<ReportCharacteristic> characteristics;
+  std::vector<ReportDefect> defects;
+  // Written by the CLI's errormap only.
+  std::optional<ReportInputs> inputs;
+  std::optional<ReportMesh> mesh;
+  std::string output_frame;  // "" when not said
+  bool pass() const { return verdict == "pass"; }
+};
+
+// The report of an error map alone (no schema, no plan), and with its plan.
+InspectionReport ErrorMapReport(const ErrorMapResult& error_map, const ErrorMapSettings& settings);
+InspectionReport MakeInspectionReport(const ErrorMapResult& error_map,
+                                      const ErrorMapSettings& settings, const PlanOutcome& outcome);
+
+// The codec. Encode then decode gives the same struct; decode then encode
+// gives the same JSON for every report this codec wrote. DecodeReport
+// refuses (DataLoss, naming the field) a value of the wrong type; a missing
+// field keeps its default.
+nlohmann::json EncodeReport(const InspectionReport& report);
+absl::StatusOr<InspectionReport> DecodeReport(const nlohmann::json& json);
+// The text of report.json (two-space indent, a final newline), and its parse.
+std::string ReportText(const InspectionReport& report);
+absl::StatusOr<InspectionReport> ParseReport(const std::string& text);
+
+// One figure of the report with its report.json key, for readers that show
+// a section whole (the HTML report's tables keep the key beside each value).
+using ReportField = JsonField;
+std::vector<ReportField> PointCountFields(const InspectionReport& report);  // count valid matched
+std::vector<ReportField> StatisticsFields(const InspectionReport& report);  // min_mm .. p99_mm
+// within, above, below, fraction_within of the +-band verdict.
+std::vector<ReportField> ToleranceCountFields(const InspectionReport& report);
+// The settings, then the inputs when there are some, each group by key.
+std::vector<ReportField> SettingsFields(const InspectionReport& report);
+
+// The sections alone, as report.json holds them.
+nlohmann::json EncodeDefects(const std::vector<ReportDefect>& defects);
+nlohmann::json ErrorMapReportJson(const ErrorMapResult& result, const ErrorMapSettings& settings);
+nlohmann::json CharacteristicsJson(const CharacteristicsResult& result);
+nlohmann::json DefectsJson(const DefectsResult& result);
+
+// ReportText(MakeInspectionReport(...)): the bytes every caller writes.
+std::string ErrorMapReportText(const ErrorMapResult& result, const ErrorMapSettings& settings,
+                               const PlanOutcome& outcome);
+
+}  // namespace surfinspect

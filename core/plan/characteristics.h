@@ -1,0 +1,69 @@
+// Characteristics: the error map judged against an inspection plan. One
+// result per characteristic: the whole surface ("surface", the plan's
+// default band), each region, each comparison point; and the part verdict.
+//
+//  * Region membership of a scanned point is its closest CAD triangle's
+//    (ResolvedInspectionPlan); a region is judged on the matched points in it.
+//  * A comparison point's value is the mean signed deviation of the scanned
+//    points whose closest CAD point lies within radius_mm of position_mm; it
+//    has no value (failing) when there is none.
+//  * A surface or region passes when it has matched points and the fraction
+//    outside its band is at most allowed_fraction_outside; a point passes
+//    when it has a value and that value is inside its band.
+//  * The part passes when every characteristic passes, and, when the plan
+//    sets defects.max_count, at most that many defects were found.
+//
+// One pass over the points, with the per-triangle rows of the resolved plan;
+// accumulated in double over fixed chunks of points and reduced in chunk
+// order, so the result does not depend on the thread count. The surface's
+// min/max/mean/stddev/rms are the error map's own statistics. Deviations are
+// mm, signed (+ above the CAD surface), positions in the part frame.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/errormap/error_map.h"
+#include "core/plan/inspection_plan.h"
+
+namespace surfinspect {
+
+enum class CharacteristicType { kSurface, kRegion, kPoint };
+const char* CharacteristicTypeName(CharacteristicType type);  // "surface" | "region" | "point"
+
+struct CharacteristicResult {
+  std::string name;
+  CharacteristicType type = CharacteristicType::kSurface;
+  bool pass = false;
+  std::string reason;  // one line, for people
+  ToleranceBand tolerance;
+  double allowed_fraction_outside = 0;  // surface and regions
+  std::size_t points = 0;               // matched points judged
+  std::size_t within = 0, above = 0, below = 0;
+  // Over those points, mm; NaN when there are none. stddev is the population one.
+  double min_mm = NAN, max_mm = NAN, mean_mm = NAN, stddev_mm = NAN, rms_mm = NAN;
+  double fraction_within = NAN;
+  double value_mm = NAN;  // points only: the mean; NaN when no point is near
+};
+
+struct CharacteristicsResult {
+  std::vector<CharacteristicResult> characteristics;  // surface, regions, points, in plan order
+  bool pass = false;       // every characteristic passes (and the defect count rule, when set)
+  std::size_t failed = 0;  // characteristics that fail
+  std::string reason;
+};
+
+struct CharacteristicsSettings {
+  int threads = 0;  // 0 = all cores; the result is the same for any value
+};
+
+// `error_map` must come from the part mesh `plan` was resolved against
+// (triangle ids below plan.num_triangles); InvalidArgument otherwise.
+// `defect_count` feeds the max_count rule; pass 0 when defects were not run.
+absl::StatusOr<CharacteristicsResult> ComputeCharacteristics(
+    const ErrorMapResult& error_map, const ResolvedInspectionPlan& plan,
+    std::size_t defect_count = 0, const CharacteristicsSettings& settings = {});
+
+}  // namespace surfinspect

@@ -1,0 +1,215 @@
+#include "core/plan/inspection_plan.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "absl/strings/str_cat.h"
+#include "core/distance/point_triangle.h"
+#include "core/types/status_macros.h"
+
+namespace surfinspect {
+namespace {
+
+absl::Status Bad(const std::string& path, absl::string_view what) {
+  return absl::InvalidArgumentError(absl::StrCat(path, ": ", what));
+}
+
+std::string Index(const std::string& path, std::size_t i) {
+  return absl::StrCat(path, "[", i, "]");
+}
+
+// ---- validation of the struct --------------------------------------------
+
+absl::Status CheckFinite(const std::string& path, double v) {
+  return std::isfinite(v) ? absl::OkStatus() : Bad(path, "not a finite number");
+}
+
+absl::Status CheckBand(const std::string& path, const ToleranceBand& b) {
+  RETURN_IF_ERROR(CheckFinite(path + ".lower", b.lower_mm));
+  RETURN_IF_ERROR(CheckFinite(path + ".upper", b.upper_mm));
+  if (b.lower_mm > b.upper_mm)
+    return Bad(path, absl::StrCat("lower (", b.lower_mm, ") > upper (", b.upper_mm, ")"));
+  return absl::OkStatus();
+}
+
+absl::Status CheckFraction(const std::string& path, double f) {
+  RETURN_IF_ERROR(CheckFinite(path, f));
+  return f >= 0 && f <= 1 ? absl::OkStatus() : Bad(path, "must be in [0, 1]");
+}
+
+absl::Status CheckSelector(const std::string& path, const RegionSelector& s,
+                           const TriangleMesh& part, const MeshGroups& groups) {
+  switch (s.kind) {
+    case RegionSelector::Kind::kBox:
+      if (!s.box_min_mm.allFinite() || !s.box_max_mm.allFinite())
+        return Bad(path + ".box_mm", "not a finite number");
+      if ((s.box_min_mm.array() >= s.box_max_mm.array()).any())
+        return Bad(path + ".box_mm", "empty or inverted box (need min < max on every axis)");
+      return absl::OkStatus();
+    case RegionSelector::Kind::kTriangles:
+      if (s.triangles.empty()) return Bad(path + ".triangles", "empty list");
+      for (std::size_t i = 0; i < s.triangles.size(); ++i)
+        if (s.triangles[i] >= part.num_triangles())
+          return Bad(Index(path + ".triangles", i),
+                     absl::StrCat("triangle id ", s.triangles[i], " out of range (the part has ",
+                                  part.num_triangles(), " triangles)"));
+      return absl::OkStatus();
+    case RegionSelector::Kind::kGroup:
+      if (std::find(groups.names.begin(), groups.names.end(), s.group) == groups.names.end())
+        return Bad(path + ".group", absl::StrCat("unknown group \"", s.group, "\" (the part has ",
+                                                 groups.names.size(), " named groups)"));
+      return absl::OkStatus();
+  }
+  return Bad(path, "unknown selector");
+}
+
+absl::Status CheckName(const std::string& path, const std::string& name,
+                       std::set<std::string>& seen) {
+  if (name.empty()) return Bad(path, "empty name");
+  if (name == kSurfaceCharacteristicName)
+    return Bad(path, "\"surface\" is reserved for the whole surface");
+  if (!seen.insert(name).second)
+    return Bad(path, absl::StrCat("duplicate name \"", name,
+                                  "\" (regions and points share one namespace)"));
+  return absl::OkStatus();
+}
+
+// ---- resolution ----------------------------------------------------------
+
+bool InRegion(const RegionSelector& s, uint32_t t, const Eigen::Vector3d& centroid,
+              const MeshGroups& groups, uint32_t group_index) {
+  switch (s.kind) {
+    case RegionSelector::Kind::kBox:
+      return (centroid.array() >= s.box_min_mm.array()).all() &&
+             (centroid.array() <= s.box_max_mm.array()).all();
+    case RegionSelector::Kind::kTriangles:
+      return std::binary_search(s.triangles.begin(), s.triangles.end(), t);
+    case RegionSelector::Kind::kGroup:
+      return !groups.triangle_group.empty() && groups.triangle_group[t] == group_index;
+  }
+  return false;
+}
+
+// Compressed rows from a per-row membership test, rows in order, ids ascending.
+template <typename F>
+void BuildRows(std::size_t rows, std::size_t ids, F member, std::vector<uint32_t>& offsets,
+               std::vector<uint32_t>& out) {
+  offsets.assign(1, 0);
+  for (std::size_t r = 0; r < rows; ++r) {
+    for (std::size_t k = 0; k < ids; ++k)
+      if (member(r, k)) out.push_back(static_cast<uint32_t>(k));
+    offsets.push_back(static_cast<uint32_t>(out.size()));
+  }
+}
+
+}  // namespace
+
+absl::Status ValidateInspectionPlan(const InspectionPlan& plan, const TriangleMesh& part,
+                                    const MeshGroups& groups, const std::string& where) {
+  if (!groups.triangle_group.empty() && groups.triangle_group.size() != part.num_triangles())
+    return Bad(where, absl::StrCat("mesh groups cover ", groups.triangle_group.size(),
+                                   " triangles, the part has ", part.num_triangles()));
+  RETURN_IF_ERROR(CheckBand(where + ".tolerance_mm", plan.tolerance));
+  if (auto st = CheckFraction(where + ".allowed_fraction_outside", plan.allowed_fraction_outside);
+      !st.ok())
+    return st;
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < plan.regions.size(); ++i) {
+    const PlanRegion& r = plan.regions[i];
+    const std::string path = Index(where + ".regions", i);
+    RETURN_IF_ERROR(CheckName(path + ".name", r.name, names));
+    RETURN_IF_ERROR(CheckSelector(path + ".select", r.select, part, groups));
+    if (r.tolerance) RETURN_IF_ERROR(CheckBand(path + ".tolerance_mm", *r.tolerance));
+    if (auto st = CheckFraction(path + ".allowed_fraction_outside", r.allowed_fraction_outside);
+        !st.ok())
+      return st;
+  }
+  for (std::size_t i = 0; i < plan.points.size(); ++i) {
+    const ComparisonPoint& p = plan.points[i];
+    const std::string path = Index(where + ".points", i);
+    RETURN_IF_ERROR(CheckName(path + ".name", p.name, names));
+    if (!p.position_mm.allFinite()) return Bad(path + ".position_mm", "not a finite number");
+    if (!p.normal.allFinite()) return Bad(path + ".normal", "not a finite number");
+    RETURN_IF_ERROR(CheckFinite(path + ".radius_mm", p.radius_mm));
+    if (!(p.radius_mm > 0)) return Bad(path + ".radius_mm", "must be > 0");
+    if (p.tolerance) RETURN_IF_ERROR(CheckBand(path + ".tolerance_mm", *p.tolerance));
+  }
+  if (plan.defects) {
+    const std::string path = where + ".defects";
+    const DefectRules& d = *plan.defects;
+    RETURN_IF_ERROR(CheckFinite(path + ".threshold_mm", d.threshold_mm));
+    if (!(d.threshold_mm > 0)) return Bad(path + ".threshold_mm", "must be > 0");
+    RETURN_IF_ERROR(CheckFinite(path + ".min_area_mm2", d.min_area_mm2));
+    if (!(d.min_area_mm2 >= 0)) return Bad(path + ".min_area_mm2", "must be >= 0");
+    if (d.max_count && *d.max_count < 0) return Bad(path + ".max_count", "must be >= 0");
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<ResolvedInspectionPlan> ResolveInspectionPlan(const InspectionPlan& plan,
+                                                             const TriangleMesh& part,
+                                                             const MeshGroups& groups) {
+  RETURN_IF_ERROR(ValidateInspectionPlan(plan, part, groups));
+  ResolvedInspectionPlan r;
+  r.plan = plan;
+  for (PlanRegion& region : r.plan.regions)
+    std::sort(region.select.triangles.begin(), region.select.triangles.end());
+  const std::size_t nt = part.num_triangles();
+  r.num_triangles = nt;
+  std::vector<uint32_t> group_index(r.plan.regions.size(), MeshGroups::kNoGroup);
+  for (std::size_t k = 0; k < r.plan.regions.size(); ++k)
+    if (r.plan.regions[k].select.kind == RegionSelector::Kind::kGroup)
+      group_index[k] = static_cast<uint32_t>(
+          std::find(groups.names.begin(), groups.names.end(), r.plan.regions[k].select.group) -
+          groups.names.begin());
+  // Centroids and corners only when a region or a point asks: the default
+  // plan (the whole surface) needs neither, and for a large mesh they are
+  // most of this function's time.
+  const bool geometry = !r.plan.regions.empty() || !r.plan.points.empty();
+  std::vector<Eigen::Vector3d> centroid(geometry ? nt : 0);
+  std::vector<std::array<Eigen::Vector3d, 3>> corners(geometry ? nt : 0);
+  for (std::size_t t = 0; t < centroid.size(); ++t) {
+    for (int c = 0; c < 3; ++c) corners[t][c] = part.vertices[part.triangles[t][c]].cast<double>();
+    centroid[t] = (corners[t][0] + corners[t][1] + corners[t][2]) / 3.0;
+  }
+  BuildRows(
+      nt, r.plan.regions.size(),
+      [&](std::size_t t, std::size_t k) {
+        return InRegion(r.plan.regions[k].select, static_cast<uint32_t>(t), centroid[t], groups,
+                        group_index[k]);
+      },
+      r.region_offsets, r.region_ids);
+  r.region_triangle_count.assign(r.plan.regions.size(), 0);
+  for (uint32_t k : r.region_ids) ++r.region_triangle_count[k];
+  // A triangle can reach a point when its closest point to the position is
+  // within the radius; the bounding-sphere test first skips the far ones.
+  std::vector<double> bound(r.plan.points.empty() ? 0 : nt);
+  for (std::size_t t = 0; t < bound.size(); ++t)
+    for (int c = 0; c < 3; ++c) bound[t] = std::max(bound[t], (corners[t][c] - centroid[t]).norm());
+  BuildRows(
+      nt, r.plan.points.size(),
+      [&](std::size_t t, std::size_t k) {
+        const ComparisonPoint& p = r.plan.points[k];
+        if ((p.position_mm - centroid[t]).norm() > p.radius_mm + bound[t]) return false;
+        const auto& v = corners[t];
+        return ClosestPointOnTriangle(p.position_mm, v[0], v[1], v[2]).squared_distance <=
+               p.radius_mm * p.radius_mm;
+      },
+      r.point_offsets, r.point_ids);
+  return r;
+}
+
+void SelectGroupsByTriangles(InspectionPlan* plan, const MeshGroups& groups) {
+  for (PlanRegion& r : plan->regions) {
+    if (r.select.kind != RegionSelector::Kind::kGroup) continue;
+    const auto g = static_cast<uint32_t>(
+        std::find(groups.names.begin(), groups.names.end(), r.select.group) - groups.names.begin());
+    r.select.kind = RegionSelector::Kind::kTriangles;
+    r.select.triangles.clear();
+    for (std::size_t t = 0; t < groups.triangle_group.size(); ++t)
+      if (groups.triangle_group[t] == g) r.select.triangles.push_back(static_cast<uint32_t>(t));
+  }
+}
+
+}  // namespace surfinspect

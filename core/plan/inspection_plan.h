@@ -1,0 +1,142 @@
+// The inspection plan: what a part is judged on, in the part (CAD) frame, mm.
+//
+//  * a default tolerance band {lower, upper} for the whole surface (the
+//    characteristic named "surface");
+//  * regions of the CAD surface, each with its own (often asymmetric) band,
+//    selected by a box (a triangle is in it when its centroid is), by
+//    triangle ids, or by a named group of the CAD file; regions may overlap;
+//  * comparison points at taught positions, each judged on the mean signed
+//    deviation of the scanned points whose closest CAD point lies within
+//    radius_mm of it;
+//  * defect detection rules (core/plan/defects.h).
+//
+// The JSON format ("schema": "surfinspect.plan/1") is documented in
+// docs/inspection-plan.md. One validator, ValidateInspectionPlan, checks the
+// struct for every source (the JSON parser here, the wire conversion); its
+// messages name the field as a JSON path, e.g.
+// "plan.regions[1].select.box_mm: empty or inverted box".
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <nlohmann/json_fwd.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "core/types/mesh_groups.h"
+#include "core/types/triangle_mesh.h"
+
+namespace surfinspect {
+
+inline constexpr char kInspectionPlanSchema[] = "surfinspect.plan/1";
+// The whole surface's characteristic; no region or point may take this name.
+inline constexpr char kSurfaceCharacteristicName[] = "surface";
+
+// lower <= deviation <= upper, mm, signed (+ above the CAD surface).
+// Deviations are float32, so Contains() rounds the edges to float32 first:
+// a deviation that prints as the edge value is inside the band. Both
+// edges are compared (&, not &&): no branch on the lower edge, which
+// mispredicts where a failing part's points fall on either side at random.
+struct ToleranceBand {
+  double lower_mm = -0.1;
+  double upper_mm = 0.1;
+  bool Contains(float deviation_mm) const {
+    return (deviation_mm >= static_cast<float>(lower_mm)) &
+           (deviation_mm <= static_cast<float>(upper_mm));
+  }
+};
+
+struct RegionSelector {
+  enum class Kind { kBox, kTriangles, kGroup };
+  Kind kind = Kind::kBox;
+  Eigen::Vector3d box_min_mm = Eigen::Vector3d::Zero();  // kBox: part frame, inclusive
+  Eigen::Vector3d box_max_mm = Eigen::Vector3d::Zero();
+  std::vector<uint32_t> triangles;  // kTriangles: ids into the part mesh
+  std::string group;                // kGroup: a name in MeshGroups::names
+};
+
+struct PlanRegion {
+  std::string name;
+  RegionSelector select;
+  std::optional<ToleranceBand> tolerance;  // unset: the plan's default band
+  double allowed_fraction_outside = 0.0;   // of the region's matched points, in [0, 1]
+};
+
+struct ComparisonPoint {
+  std::string name;
+  Eigen::Vector3d position_mm = Eigen::Vector3d::Zero();  // part frame, on or near the surface
+  // The taught surface normal (unit after parsing), or zero when not given.
+  // Informational: the value is the signed deviation along the CAD normal.
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  double radius_mm = 2.0;  // > 0
+  std::optional<ToleranceBand> tolerance;
+};
+
+struct DefectRules {
+  double threshold_mm = 0.05;  // |robust local deviation| above this is defective; > 0
+  double min_area_mm2 = 3.0;   // smaller patches are not reported; >= 0
+  // When set, the part fails with more than max_count defects; unset, defects
+  // never change the verdict.
+  std::optional<int> max_count;
+};
+
+struct InspectionPlan {
+  ToleranceBand tolerance;                // the surface's band and the default
+  double allowed_fraction_outside = 0.0;  // for the surface characteristic
+  std::vector<PlanRegion> regions;
+  std::vector<ComparisonPoint> points;
+  std::optional<DefectRules> defects;  // unset: no defect detection
+};
+
+// Checks the plan against the part it will be applied to: finite numbers,
+// lower <= upper, a non-empty box with min <= max, radius > 0, fractions in
+// [0, 1], triangle ids in range, groups that exist, non-empty names unique
+// across regions and points and not "surface". InvalidArgument, the message
+// starting with `where` and the field's path.
+absl::Status ValidateInspectionPlan(const InspectionPlan& plan, const TriangleMesh& part,
+                                    const MeshGroups& groups = {},
+                                    const std::string& where = "plan");
+
+// Parses the JSON form and validates it. Unknown keys and wrong types are
+// refused with the field named; "schema", when present, must be
+// "surfinspect.plan/1".
+absl::StatusOr<InspectionPlan> ParseInspectionPlan(const nlohmann::json& json,
+                                                   const TriangleMesh& part,
+                                                   const std::string& where = "plan",
+                                                   const MeshGroups& groups = {});
+
+// The plan applied to a mesh: which regions each triangle belongs to, and
+// which comparison points each triangle can reach (a triangle within
+// radius_mm of the point's position), both as compressed rows.
+struct ResolvedInspectionPlan {
+  InspectionPlan plan;
+  std::size_t num_triangles = 0;
+  // Regions of triangle t: region_ids[region_offsets[t] .. region_offsets[t+1]).
+  std::vector<uint32_t> region_offsets;
+  std::vector<uint32_t> region_ids;
+  // Comparison points triangle t can reach, likewise.
+  std::vector<uint32_t> point_offsets;
+  std::vector<uint32_t> point_ids;
+  std::vector<std::size_t> region_triangle_count;  // per region
+
+  // The first region (plan order) containing triangle t, or -1.
+  int FirstRegionOf(uint32_t t) const {
+    if (t >= num_triangles || region_offsets[t] == region_offsets[t + 1]) return -1;
+    return static_cast<int>(region_ids[region_offsets[t]]);
+  }
+};
+
+// Turns every group selector into the triangle ids of its group, so the plan
+// no longer needs the CAD file's groups (a server gets the plan, not the
+// file). The plan was validated against `groups`.
+void SelectGroupsByTriangles(InspectionPlan* plan, const MeshGroups& groups);
+
+// Validates, then resolves. Region ids per triangle are in increasing order.
+absl::StatusOr<ResolvedInspectionPlan> ResolveInspectionPlan(const InspectionPlan& plan,
+                                                             const TriangleMesh& part,
+                                                             const MeshGroups& groups = {});
+
+}  // namespace surfinspect

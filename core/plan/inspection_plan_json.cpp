@@ -1,0 +1,221 @@
+// The JSON form of the inspection plan (docs/inspection-plan.md): keys and
+// types are checked here, naming the field; the values then go through
+// ValidateInspectionPlan like a plan from any other source.
+#include <cmath>
+#include <initializer_list>
+#include <nlohmann/json.hpp>
+
+#include "absl/strings/str_cat.h"
+#include "core/plan/inspection_plan.h"
+#include "core/types/status_macros.h"
+
+namespace surfinspect {
+namespace {
+
+using nlohmann::json;
+
+absl::Status Bad(const std::string& path, absl::string_view what) {
+  return absl::InvalidArgumentError(absl::StrCat(path, ": ", what));
+}
+
+std::string Index(const std::string& path, std::size_t i) {
+  return absl::StrCat(path, "[", i, "]");
+}
+
+// ---- JSON reading ----------------------------------------------------------
+
+absl::Status CheckKeys(const json& j, const std::string& path,
+                       std::initializer_list<const char*> allowed) {
+  if (!j.is_object()) return Bad(path, "must be an object");
+  for (const auto& [key, value] : j.items()) {
+    bool known = false;
+    for (const char* a : allowed) known = known || key == a;
+    if (!known) return Bad(absl::StrCat(path, ".", key), "unknown key");
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<double> Number(const json& j, const std::string& path) {
+  if (!j.is_number()) return Bad(path, "must be a number");
+  const double v = j.get<double>();
+  if (!std::isfinite(v)) return Bad(path, "not a finite number");
+  return v;
+}
+
+absl::StatusOr<Eigen::Vector3d> Vector3(const json& j, const std::string& path) {
+  if (!j.is_array() || j.size() != 3) return Bad(path, "must be an array of 3 numbers");
+  Eigen::Vector3d v;
+  for (int a = 0; a < 3; ++a) {
+    ASSIGN_OR_RETURN(auto x, Number(j[a], Index(path, a)));
+    v[a] = x;
+  }
+  return v;
+}
+
+absl::StatusOr<std::string> String(const json& j, const std::string& path) {
+  if (!j.is_string()) return Bad(path, "must be a string");
+  return j.get<std::string>();
+}
+
+absl::StatusOr<ToleranceBand> Band(const json& j, const std::string& path) {
+  if (auto st = CheckKeys(j, path, {"lower", "upper"}); !st.ok()) return st;
+  if (!j.contains("lower") || !j.contains("upper")) return Bad(path, "needs lower and upper");
+  ToleranceBand b;
+  ASSIGN_OR_RETURN(auto lo, Number(j["lower"], path + ".lower"));
+  ASSIGN_OR_RETURN(auto hi, Number(j["upper"], path + ".upper"));
+  b.lower_mm = lo;
+  b.upper_mm = hi;
+  return b;
+}
+
+absl::StatusOr<RegionSelector> Selector(const json& j, const std::string& path) {
+  if (auto st = CheckKeys(j, path, {"box_mm", "triangles", "group"}); !st.ok()) return st;
+  if (j.size() != 1) return Bad(path, "needs exactly one of box_mm, triangles, group");
+  RegionSelector s;
+  if (j.contains("box_mm")) {
+    const json& b = j["box_mm"];
+    const std::string p = path + ".box_mm";
+    if (!b.is_array() || b.size() != 2)
+      return Bad(p, "must be [[xmin, ymin, zmin], [xmax, ymax, zmax]]");
+    ASSIGN_OR_RETURN(auto lo, Vector3(b[0], Index(p, 0)));
+    ASSIGN_OR_RETURN(auto hi, Vector3(b[1], Index(p, 1)));
+    s.box_min_mm = lo;
+    s.box_max_mm = hi;
+  } else if (j.contains("triangles")) {
+    s.kind = RegionSelector::Kind::kTriangles;
+    const json& t = j["triangles"];
+    const std::string p = path + ".triangles";
+    if (!t.is_array()) return Bad(p, "must be an array of triangle ids");
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      if (!t[i].is_number_integer() || t[i].get<int64_t>() < 0 ||
+          t[i].get<int64_t>() > int64_t{UINT32_MAX - 1})
+        return Bad(Index(p, i), "triangle id must be an integer in [0, 2^32 - 2]");
+      s.triangles.push_back(static_cast<uint32_t>(t[i].get<int64_t>()));
+    }
+  } else {
+    s.kind = RegionSelector::Kind::kGroup;
+    ASSIGN_OR_RETURN(auto g, String(j["group"], path + ".group"));
+    s.group = g;
+  }
+  return s;
+}
+
+absl::StatusOr<PlanRegion> Region(const json& j, const std::string& path) {
+  if (auto st = CheckKeys(j, path, {"name", "select", "tolerance_mm", "allowed_fraction_outside"});
+      !st.ok())
+    return st;
+  PlanRegion r;
+  if (!j.contains("name")) return Bad(path + ".name", "missing");
+  ASSIGN_OR_RETURN(auto name, String(j["name"], path + ".name"));
+  r.name = name;
+  if (!j.contains("select")) return Bad(path + ".select", "missing");
+  ASSIGN_OR_RETURN(r.select, Selector(j["select"], path + ".select"));
+  if (j.contains("tolerance_mm")) {
+    ASSIGN_OR_RETURN(auto b, Band(j["tolerance_mm"], path + ".tolerance_mm"));
+    r.tolerance = b;
+  }
+  if (j.contains("allowed_fraction_outside")) {
+    ASSIGN_OR_RETURN(auto f,
+                     Number(j["allowed_fraction_outside"], path + ".allowed_fraction_outside"));
+    r.allowed_fraction_outside = f;
+  }
+  return r;
+}
+
+absl::StatusOr<ComparisonPoint> Point(const json& j, const std::string& path) {
+  if (auto st = CheckKeys(j, path, {"name", "position_mm", "normal", "radius_mm", "tolerance_mm"});
+      !st.ok())
+    return st;
+  ComparisonPoint p;
+  if (!j.contains("name")) return Bad(path + ".name", "missing");
+  ASSIGN_OR_RETURN(auto name, String(j["name"], path + ".name"));
+  p.name = name;
+  if (!j.contains("position_mm")) return Bad(path + ".position_mm", "missing");
+  ASSIGN_OR_RETURN(auto pos, Vector3(j["position_mm"], path + ".position_mm"));
+  p.position_mm = pos;
+  if (j.contains("normal")) {
+    ASSIGN_OR_RETURN(auto n, Vector3(j["normal"], path + ".normal"));
+    if (!(n.norm() > 1e-12)) return Bad(path + ".normal", "zero vector");
+    p.normal = n.normalized();
+  }
+  if (j.contains("radius_mm")) {
+    ASSIGN_OR_RETURN(auto r, Number(j["radius_mm"], path + ".radius_mm"));
+    p.radius_mm = r;
+  }
+  if (j.contains("tolerance_mm")) {
+    ASSIGN_OR_RETURN(auto b, Band(j["tolerance_mm"], path + ".tolerance_mm"));
+    p.tolerance = b;
+  }
+  return p;
+}
+
+absl::StatusOr<DefectRules> Defects(const json& j, const std::string& path) {
+  if (auto st = CheckKeys(j, path, {"threshold_mm", "min_area_mm2", "max_count"}); !st.ok())
+    return st;
+  DefectRules d;
+  if (j.contains("threshold_mm")) {
+    ASSIGN_OR_RETURN(auto v, Number(j["threshold_mm"], path + ".threshold_mm"));
+    d.threshold_mm = v;
+  }
+  if (j.contains("min_area_mm2")) {
+    ASSIGN_OR_RETURN(auto v, Number(j["min_area_mm2"], path + ".min_area_mm2"));
+    d.min_area_mm2 = v;
+  }
+  if (j.contains("max_count")) {
+    const json& m = j["max_count"];
+    if (!m.is_number_integer() || m.get<int64_t>() < 0 || m.get<int64_t>() > 1000000)
+      return Bad(path + ".max_count", "must be an integer in [0, 1000000]");
+    d.max_count = static_cast<int>(m.get<int64_t>());
+  }
+  return d;
+}
+
+template <typename T, typename F>
+absl::Status List(const json& j, const std::string& path, F parse, std::vector<T>& out) {
+  if (!j.is_array()) return Bad(path, "must be an array");
+  for (std::size_t i = 0; i < j.size(); ++i) {
+    ASSIGN_OR_RETURN(auto item, parse(j[i], Index(path, i)));
+    out.push_back(std::move(item));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::StatusOr<InspectionPlan> ParseInspectionPlan(const json& j, const TriangleMesh& part,
+                                                   const std::string& where,
+                                                   const MeshGroups& groups) {
+  if (auto st = CheckKeys(
+          j, where,
+          {"schema", "tolerance_mm", "allowed_fraction_outside", "regions", "points", "defects"});
+      !st.ok())
+    return st;
+  InspectionPlan plan;
+  if (j.contains("schema")) {
+    ASSIGN_OR_RETURN(auto s, String(j["schema"], where + ".schema"));
+    if (s != kInspectionPlanSchema)
+      return Bad(where + ".schema", absl::StrCat("unsupported \"", s, "\" (this version reads \"",
+                                                 kInspectionPlanSchema, "\")"));
+  }
+  if (j.contains("tolerance_mm")) {
+    ASSIGN_OR_RETURN(auto b, Band(j["tolerance_mm"], where + ".tolerance_mm"));
+    plan.tolerance = b;
+  }
+  if (j.contains("allowed_fraction_outside")) {
+    ASSIGN_OR_RETURN(auto f,
+                     Number(j["allowed_fraction_outside"], where + ".allowed_fraction_outside"));
+    plan.allowed_fraction_outside = f;
+  }
+  if (j.contains("regions"))
+    RETURN_IF_ERROR(List(j["regions"], where + ".regions", Region, plan.regions));
+  if (j.contains("points"))
+    RETURN_IF_ERROR(List(j["points"], where + ".points", Point, plan.points));
+  if (j.contains("defects")) {
+    ASSIGN_OR_RETURN(auto d, Defects(j["defects"], where + ".defects"));
+    plan.defects = d;
+  }
+  RETURN_IF_ERROR(ValidateInspectionPlan(plan, part, groups, where));
+  return plan;
+}
+
+}  // namespace surfinspect

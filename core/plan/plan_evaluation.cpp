@@ -1,0 +1,64 @@
+#include "core/plan/plan_evaluation.h"
+
+#include "absl/strings/str_cat.h"
+#include "core/io/io_mesh.h"
+#include "core/types/status_macros.h"
+
+namespace surfinspect {
+
+InspectionPlan PlanFromSettings(const ErrorMapSettings& settings) {
+  InspectionPlan plan;
+  plan.tolerance = {-settings.tolerance_mm, settings.tolerance_mm};
+  plan.allowed_fraction_outside = settings.allowed_fraction_outside;
+  return plan;
+}
+
+absl::StatusOr<InspectionPlan> ParsePlanWithDefaults(const nlohmann::json& json,
+                                                     const TriangleMesh& part,
+                                                     const ErrorMapSettings& settings,
+                                                     const std::string& where,
+                                                     const MeshGroups& groups) {
+  if (!json.is_object()) return absl::InvalidArgumentError(where + ": must be an object");
+  nlohmann::json with = json;
+  if (!with.contains("tolerance_mm"))
+    with["tolerance_mm"] = {{"lower", -settings.tolerance_mm}, {"upper", settings.tolerance_mm}};
+  if (!with.contains("allowed_fraction_outside"))
+    with["allowed_fraction_outside"] = settings.allowed_fraction_outside;
+  auto plan = ParseInspectionPlan(with, part, where, groups);
+  if (plan.ok()) SelectGroupsByTriangles(&*plan, groups);
+  return plan;
+}
+
+absl::StatusOr<InspectionPlan> ParsePlanForMeshFile(const nlohmann::json& json,
+                                                    const TriangleMesh& part,
+                                                    const std::string& mesh_path,
+                                                    const ErrorMapSettings& settings,
+                                                    const std::string& where) {
+  const absl::StatusOr<MeshGroups> groups = ReadMeshGroups(mesh_path, part);
+  auto plan =
+      ParsePlanWithDefaults(json, part, settings, where, groups.ok() ? *groups : MeshGroups{});
+  if (plan.ok() || groups.ok()) return plan;
+  return absl::Status(plan.status().code(),
+                      absl::StrCat(plan.status().message(), " (", groups.status().message(), ")"));
+}
+
+absl::StatusOr<PlanOutcome> EvaluatePlan(const ErrorMapResult& error_map, const PointCloud& cloud,
+                                         const TriangleMesh& part, const InspectionPlan& plan,
+                                         int threads) {
+  ASSIGN_OR_RETURN(auto resolved, ResolveInspectionPlan(plan, part));
+  PlanOutcome out;
+  if (plan.defects) {
+    DefectSettings ds;
+    ds.threads = threads;
+    ASSIGN_OR_RETURN(out.defects,
+                     FindDefects(error_map, cloud, part, *plan.defects, &resolved, ds));
+    out.defects_run = true;
+  }
+  CharacteristicsSettings cs;
+  cs.threads = threads;
+  ASSIGN_OR_RETURN(out.characteristics,
+                   ComputeCharacteristics(error_map, resolved, out.defects.defects.size(), cs));
+  return out;
+}
+
+}  // namespace surfinspect

@@ -1,0 +1,66 @@
+// The error map judged against an inspection plan, for every caller (the
+// CLI's errormap and inspect, the ErrorMap and Inspect RPCs, the cell-agent):
+// the plan is resolved on the part mesh, defects are found when the plan
+// asks for them (core/plan/defects.h), and every characteristic and the
+// part verdict are computed (core/plan/characteristics.h). The report.json
+// text is core/pipeline/inspection_report.h's, so every caller writes the
+// same bytes.
+//
+// Without a plan a part is judged by PlanFromSettings: the whole surface
+// against the error map's +-tolerance_mm and allowed_fraction_outside, so the
+// part verdict is the tolerance verdict. Units mm, part frame.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "core/errormap/error_map.h"
+#include "core/plan/characteristics.h"
+#include "core/plan/defects.h"
+#include "core/plan/inspection_plan.h"
+#include "core/types/point_cloud.h"
+#include "core/types/triangle_mesh.h"
+
+namespace surfinspect {
+
+// The plan of a caller without one: the surface only, band {-t, +t} and the
+// settings' allowed_fraction_outside.
+InspectionPlan PlanFromSettings(const ErrorMapSettings& settings);
+
+// ParseInspectionPlan with the error-map settings as defaults: a plan
+// without "tolerance_mm" takes {-t, +t} of settings.tolerance_mm, one without
+// "allowed_fraction_outside" takes the settings' (the symmetric --tolerance
+// is the shorthand of the plan's band). Group selectors name `groups` of the
+// CAD file and come back as the triangle ids of their group.
+absl::StatusOr<InspectionPlan> ParsePlanWithDefaults(const nlohmann::json& json,
+                                                     const TriangleMesh& part,
+                                                     const ErrorMapSettings& settings,
+                                                     const std::string& where = "plan",
+                                                     const MeshGroups& groups = {});
+
+// ParsePlanWithDefaults with the groups of the CAD file `mesh_path` that
+// `part` was read from (io_mesh.h ReadMeshGroups). A file whose groups cannot
+// be read has none; a plan that selects one is then refused with that reason.
+absl::StatusOr<InspectionPlan> ParsePlanForMeshFile(const nlohmann::json& json,
+                                                    const TriangleMesh& part,
+                                                    const std::string& mesh_path,
+                                                    const ErrorMapSettings& settings,
+                                                    const std::string& where = "plan");
+
+struct PlanOutcome {
+  CharacteristicsResult characteristics;  // surface, regions, points
+  bool defects_run = false;               // the plan has defect rules
+  DefectsResult defects;                  // empty unless defects_run
+  bool pass() const { return characteristics.pass; }
+};
+
+// `cloud` is the cloud `error_map` was computed on (any frame), `part` the
+// mesh it was computed against. InvalidArgument (field named, "plan...")
+// for a plan that does not fit the part.
+absl::StatusOr<PlanOutcome> EvaluatePlan(const ErrorMapResult& error_map, const PointCloud& cloud,
+                                         const TriangleMesh& part, const InspectionPlan& plan,
+                                         int threads = 0);
+
+}  // namespace surfinspect

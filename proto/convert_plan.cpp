@@ -1,0 +1,129 @@
+// proto/convert.h: the inspection plan.
+#include "absl/strings/str_cat.h"
+#include "core/types/status_macros.h"
+#include "proto/convert.h"
+#include "proto/convert_helpers.h"
+
+namespace surfinspect::wire {
+namespace {
+
+absl::StatusOr<PlanRegion> RegionFromProto(const v1::PlanRegion& msg, const std::string& field) {
+  PlanRegion r;
+  r.name = msg.name();
+  if (msg.has_tolerance_mm()) r.tolerance = BandFromProto(msg.tolerance_mm());
+  if (msg.has_allowed_fraction_outside())
+    r.allowed_fraction_outside = msg.allowed_fraction_outside();
+  const v1::RegionSelect& s = msg.select();
+  switch (s.selector_case()) {
+    case v1::RegionSelect::kBoxMm: {
+      r.select.kind = RegionSelector::Kind::kBox;
+      ASSIGN_OR_RETURN(auto lo,
+                       Vector3FromProto(s.box_mm().min_mm(), field + ".select.box_mm.min_mm"));
+      ASSIGN_OR_RETURN(auto hi,
+                       Vector3FromProto(s.box_mm().max_mm(), field + ".select.box_mm.max_mm"));
+      r.select.box_min_mm = lo;
+      r.select.box_max_mm = hi;
+      break;
+    }
+    case v1::RegionSelect::kTriangles:
+      r.select.kind = RegionSelector::Kind::kTriangles;
+      r.select.triangles.assign(s.triangles().ids().begin(), s.triangles().ids().end());
+      break;
+    case v1::RegionSelect::kGroup:
+      r.select.kind = RegionSelector::Kind::kGroup;
+      r.select.group = s.group();
+      break;
+    default:
+      return Invalid(field + ".select", "needs exactly one selector (box_mm, triangles, group)");
+  }
+  return r;
+}
+
+absl::StatusOr<ComparisonPoint> PointFromProto(const v1::ComparisonPoint& msg,
+                                               const std::string& field) {
+  ComparisonPoint p;
+  p.name = msg.name();
+  ASSIGN_OR_RETURN(auto pos, Vector3FromProto(msg.position_mm(), field + ".position_mm"));
+  p.position_mm = pos;
+  if (msg.normal_size() != 0) {
+    ASSIGN_OR_RETURN(auto n, Vector3FromProto(msg.normal(), field + ".normal"));
+    if (!(n.norm() > 0) || !n.allFinite())
+      return Invalid(field + ".normal", "must be a finite non-zero vector");
+    p.normal = n.normalized();
+  }
+  if (msg.has_radius_mm()) p.radius_mm = msg.radius_mm();
+  if (msg.has_tolerance_mm()) p.tolerance = BandFromProto(msg.tolerance_mm());
+  return p;
+}
+
+}  // namespace
+
+absl::StatusOr<InspectionPlan> PlanFromProto(const v1::InspectionPlan& msg,
+                                             const ErrorMapSettings& defaults,
+                                             const std::string& field) {
+  InspectionPlan plan = PlanFromSettings(defaults);
+  if (msg.has_tolerance_mm()) plan.tolerance = BandFromProto(msg.tolerance_mm());
+  if (msg.has_allowed_fraction_outside())
+    plan.allowed_fraction_outside = msg.allowed_fraction_outside();
+  for (int i = 0; i < msg.regions_size(); ++i) {
+    ASSIGN_OR_RETURN(auto r,
+                     RegionFromProto(msg.regions(i), absl::StrCat(field, ".regions[", i, "]")));
+    plan.regions.push_back(std::move(r));
+  }
+  for (int i = 0; i < msg.points_size(); ++i) {
+    ASSIGN_OR_RETURN(auto p,
+                     PointFromProto(msg.points(i), absl::StrCat(field, ".points[", i, "]")));
+    plan.points.push_back(std::move(p));
+  }
+  if (msg.has_defects()) {
+    DefectRules d;
+    const v1::DefectRules& m = msg.defects();
+    if (m.has_threshold_mm()) d.threshold_mm = m.threshold_mm();
+    if (m.has_min_area_mm2()) d.min_area_mm2 = m.min_area_mm2();
+    if (m.has_max_count()) d.max_count = m.max_count();
+    plan.defects = d;
+  }
+  return plan;
+}
+
+void PlanToProto(const InspectionPlan& plan, v1::InspectionPlan* msg) {
+  msg->Clear();
+  BandToProto(plan.tolerance, msg->mutable_tolerance_mm());
+  msg->set_allowed_fraction_outside(plan.allowed_fraction_outside);
+  for (const PlanRegion& r : plan.regions) {
+    v1::PlanRegion* m = msg->add_regions();
+    m->set_name(r.name);
+    if (r.tolerance) BandToProto(*r.tolerance, m->mutable_tolerance_mm());
+    m->set_allowed_fraction_outside(r.allowed_fraction_outside);
+    v1::RegionSelect* s = m->mutable_select();
+    switch (r.select.kind) {
+      case RegionSelector::Kind::kBox:
+        Vector3ToProto(r.select.box_min_mm, s->mutable_box_mm()->mutable_min_mm());
+        Vector3ToProto(r.select.box_max_mm, s->mutable_box_mm()->mutable_max_mm());
+        break;
+      case RegionSelector::Kind::kTriangles:
+        for (uint32_t t : r.select.triangles) s->mutable_triangles()->add_ids(t);
+        s->mutable_triangles();  // an empty list is still this selector
+        break;
+      case RegionSelector::Kind::kGroup:
+        s->set_group(r.select.group);
+        break;
+    }
+  }
+  for (const ComparisonPoint& p : plan.points) {
+    v1::ComparisonPoint* m = msg->add_points();
+    m->set_name(p.name);
+    Vector3ToProto(p.position_mm, m->mutable_position_mm());
+    if (p.normal != Eigen::Vector3d::Zero()) Vector3ToProto(p.normal, m->mutable_normal());
+    m->set_radius_mm(p.radius_mm);
+    if (p.tolerance) BandToProto(*p.tolerance, m->mutable_tolerance_mm());
+  }
+  if (plan.defects) {
+    v1::DefectRules* d = msg->mutable_defects();
+    d->set_threshold_mm(plan.defects->threshold_mm);
+    d->set_min_area_mm2(plan.defects->min_area_mm2);
+    if (plan.defects->max_count) d->set_max_count(*plan.defects->max_count);
+  }
+}
+
+}  // namespace surfinspect::wire

@@ -1,0 +1,254 @@
+// core/plan/plan_evaluation.cpp: the plan glue every caller runs, checked
+// against the core functions it chains (ResolveInspectionPlan, FindDefects,
+// ComputeCharacteristics) called directly, and the report/2 schema.
+#include "core/plan/plan_evaluation.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <random>
+
+#include "core/io/io_mesh.h"
+#include "core/pipeline/inspection_report.h"
+#include "tests/support/plane_scan.h"
+#include "tests/support/temp_dir.h"
+#include "tests/support/test_meshes.h"
+
+namespace surfinspect {
+namespace {
+
+// The plane z = 0 over [0, 50]^2 scanned as a 160 x 160 grid at 0.25 mm
+// pitch with noise 0.015 mm, a dent (-0.2 mm, sigma 2 mm) at (20, 20) and a
+// bump (+0.15 mm, sigma 3 mm) at (35, 30).
+struct Scene {
+  TriangleMesh mesh;
+  PointCloud cloud;
+  ErrorMapResult error_map;
+};
+
+Scene MakeScene(const ErrorMapSettings& settings = {}) {
+  Scene s;
+  s.mesh = testing::HeightField(0, 50, 0, 50, 11, 11, [](double, double) { return 0.0; });
+  std::mt19937_64 rng(5);
+  s.cloud = testing::PlaneScan(160, 0.015, {{20, 20, -0.2, 2.0}, {35, 30, 0.15, 3.0}}, rng);
+  auto index = MeshIndex::Build(s.mesh);
+  EXPECT_TRUE(index.ok());
+  auto em = ComputeErrorMap(**index, s.cloud, Eigen::Isometry3d::Identity(), settings);
+  EXPECT_TRUE(em.ok()) << em.status();
+  s.error_map = *std::move(em);
+  return s;
+}
+
+nlohmann::json PlanJson() {
+  return nlohmann::json::parse(R"({
+    "regions": [{"name": "left", "select": {"box_mm": [[0, 0, -1], [25, 50, 1]]},
+                 "tolerance_mm": {"lower": -0.25, "upper": 0.25}}],
+    "points": [{"name": "dent", "position_mm": [20, 20, 0], "radius_mm": 1.0},
+               {"name": "flat", "position_mm": [40, 10, 0]}],
+    "defects": {"threshold_mm": 0.03, "min_area_mm2": 3.0}
+  })");
+}
+
+TEST(PlanEvaluation, WithoutAPlanThePartVerdictIsTheToleranceVerdict) {
+  for (double tol : {0.1, 0.3}) {
+    ErrorMapSettings settings;
+    settings.tolerance_mm = tol;
+    const Scene s = MakeScene(settings);
+    auto out = EvaluatePlan(s.error_map, s.cloud, s.mesh, PlanFromSettings(settings));
+    ASSERT_TRUE(out.ok()) << out.status();
+    EXPECT_EQ(out->pass(), s.error_map.verdict.pass) << tol;
+    EXPECT_EQ(out->pass(), tol == 0.3) << "the dent is 0.2 mm deep";
+    ASSERT_EQ(out->characteristics.characteristics.size(), 1u);
+    const CharacteristicResult& surface = out->characteristics.characteristics[0];
+    EXPECT_EQ(surface.name, "surface");
+    EXPECT_EQ(surface.within, s.error_map.verdict.within);
+    EXPECT_EQ(surface.points, s.error_map.stats.matched);
+    EXPECT_FALSE(out->defects_run);
+    EXPECT_TRUE(out->defects.defects.empty());
+  }
+}
+
+TEST(PlanEvaluation, EqualsTheCoreFunctionsCalledDirectly) {
+  const Scene s = MakeScene();
+  auto plan = ParsePlanWithDefaults(PlanJson(), s.mesh, {});
+  ASSERT_TRUE(plan.ok()) << plan.status();
+  auto out = EvaluatePlan(s.error_map, s.cloud, s.mesh, *plan);
+  ASSERT_TRUE(out.ok()) << out.status();
+  auto resolved = ResolveInspectionPlan(*plan, s.mesh);
+  ASSERT_TRUE(resolved.ok());
+  auto defects = FindDefects(s.error_map, s.cloud, s.mesh, *plan->defects, &*resolved);
+  ASSERT_TRUE(defects.ok());
+  auto judged = ComputeCharacteristics(s.error_map, *resolved, defects->defects.size());
+  ASSERT_TRUE(judged.ok());
+  EXPECT_TRUE(out->defects_run);
+  EXPECT_EQ(DefectsJson(out->defects), DefectsJson(*defects));
+  EXPECT_EQ(CharacteristicsJson(out->characteristics), CharacteristicsJson(*judged));
+  ASSERT_EQ(out->defects.defects.size(), 2u);
+  EXPECT_EQ(out->defects.defects[0].kind, DefectKind::kDent);
+  EXPECT_EQ(out->defects.defects[0].region, "left");
+  EXPECT_EQ(out->defects.defects[1].region, "");
+  // surface fails at +-0.1 (the dent), "left" passes at +-0.25, the dent's
+  // comparison point reads the Gaussian's mean over a 1 mm disc,
+  // -0.2 * 2 s^2 (1 - exp(-1 / (2 s^2))) at s = 2, and fails; the flat one passes.
+  const auto& c = out->characteristics.characteristics;
+  ASSERT_EQ(c.size(), 4u);
+  EXPECT_FALSE(c[0].pass);
+  EXPECT_TRUE(c[1].pass) << c[1].reason;
+  EXPECT_NEAR(c[2].value_mm, -0.2 * 8 * (1 - std::exp(-1.0 / 8)), 0.005);
+  EXPECT_FALSE(c[2].pass);
+  EXPECT_TRUE(c[3].pass) << c[3].reason;
+  EXPECT_FALSE(out->pass());
+}
+
+TEST(PlanEvaluation, DefectsFailThePartOnlyWithMaxCount) {
+  const Scene s = MakeScene();
+  nlohmann::json j = PlanJson();
+  j["tolerance_mm"] = {{"lower", -0.3}, {"upper", 0.3}};
+  j["points"] = nlohmann::json::array();
+  auto plan = ParsePlanWithDefaults(j, s.mesh, {});
+  ASSERT_TRUE(plan.ok()) << plan.status();
+  auto out = EvaluatePlan(s.error_map, s.cloud, s.mesh, *plan);
+  ASSERT_TRUE(out.ok());
+  EXPECT_EQ(out->defects.defects.size(), 2u);
+  EXPECT_TRUE(out->pass()) << out->characteristics.reason;
+  j["defects"]["max_count"] = 1;
+  plan = ParsePlanWithDefaults(j, s.mesh, {});
+  ASSERT_TRUE(plan.ok()) << plan.status();
+  out = EvaluatePlan(s.error_map, s.cloud, s.mesh, *plan);
+  ASSERT_TRUE(out.ok());
+  EXPECT_FALSE(out->pass());
+  EXPECT_EQ(out->characteristics.failed, 0u) << "every characteristic passes";
+}
+
+TEST(PlanEvaluation, TheSettingsAreThePlansDefaults) {
+  const Scene s = MakeScene();
+  ErrorMapSettings settings;
+  settings.tolerance_mm = 0.25;
+  settings.allowed_fraction_outside = 0.01;
+  auto plan = ParsePlanWithDefaults(nlohmann::json::object(), s.mesh, settings);
+  ASSERT_TRUE(plan.ok());
+  EXPECT_EQ(plan->tolerance.lower_mm, -0.25);
+  EXPECT_EQ(plan->tolerance.upper_mm, 0.25);
+  EXPECT_EQ(plan->allowed_fraction_outside, 0.01);
+  plan = ParsePlanWithDefaults(
+      nlohmann::json::parse(R"({"tolerance_mm": {"lower": -0.05, "upper": 0.15},
+                                "allowed_fraction_outside": 0})"),
+      s.mesh, settings);
+  ASSERT_TRUE(plan.ok());
+  EXPECT_EQ(plan->tolerance.lower_mm, -0.05);
+  EXPECT_EQ(plan->tolerance.upper_mm, 0.15);
+  EXPECT_EQ(plan->allowed_fraction_outside, 0.0);
+}
+
+TEST(PlanEvaluation, BadPlansNameTheField) {
+  const Scene s = MakeScene();
+  nlohmann::json j = PlanJson();
+  j["regions"][0]["select"]["box_mm"] = {{30, 0, -1}, {25, 50, 1}};
+  auto plan = ParsePlanWithDefaults(j, s.mesh, {});
+  ASSERT_EQ(plan.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(plan.status().message().substr(0, 26), "plan.regions[0].select.box") << plan.status();
+  j = PlanJson();
+  j["tolerance"] = 0.1;
+  plan = ParsePlanWithDefaults(j, s.mesh, {});
+  EXPECT_EQ(plan.status().message(), "plan.tolerance: unknown key");
+  EXPECT_EQ(ParsePlanWithDefaults(nlohmann::json::array(), s.mesh, {}).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  // A plan that does not fit the mesh is refused by EvaluatePlan too.
+  InspectionPlan bad;
+  bad.regions.push_back({"t", {}, {}, 0});
+  bad.regions[0].select.kind = RegionSelector::Kind::kTriangles;
+  bad.regions[0].select.triangles = {static_cast<uint32_t>(s.mesh.num_triangles())};
+  auto out = EvaluatePlan(s.error_map, s.cloud, s.mesh, bad);
+  EXPECT_EQ(out.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(out.status().message().find("plan.regions[0].select.triangles[0]"), std::string::npos)
+      << out.status();
+}
+
+TEST(PlanEvaluation, ReportTwoKeepsTheErrorMapBlocksAndAddsTheResults) {
+  const Scene s = MakeScene();
+  auto plan = ParsePlanWithDefaults(PlanJson(), s.mesh, {});
+  ASSERT_TRUE(plan.ok());
+  auto out = EvaluatePlan(s.error_map, s.cloud, s.mesh, *plan);
+  ASSERT_TRUE(out.ok());
+  const nlohmann::json old = ErrorMapReportJson(s.error_map, {});
+  const nlohmann::json j = EncodeReport(MakeInspectionReport(s.error_map, {}, *out));
+  for (const auto& [key, value] : old.items()) EXPECT_EQ(j.at(key), value) << key;
+  EXPECT_EQ(j.size(), old.size() + 4);
+  EXPECT_EQ(j["schema"], "surfinspect.report/2");
+  EXPECT_EQ(j["verdict"], "fail");
+  EXPECT_EQ(j["characteristics"], CharacteristicsJson(out->characteristics));
+  EXPECT_EQ(j["defects"], DefectsJson(out->defects));
+  // Without a plan: the surface characteristic and an empty defects list.
+  auto none = EvaluatePlan(s.error_map, s.cloud, s.mesh, PlanFromSettings({}));
+  ASSERT_TRUE(none.ok());
+  const nlohmann::json k = EncodeReport(MakeInspectionReport(s.error_map, {}, *none));
+  EXPECT_EQ(k["verdict"], k["tolerance"]["verdict"]);
+  ASSERT_EQ(k["characteristics"].size(), 1u);
+  EXPECT_EQ(k["characteristics"][0]["name"], "surface");
+  EXPECT_EQ(k["characteristics"][0]["tolerance_mm"]["lower"], -0.1);
+  EXPECT_TRUE(k["defects"].is_array() && k["defects"].empty());
+}
+
+// A region that selects an OBJ group judges the same points as a box around
+// the same triangles: the file's `g left` / `g right` split the plane at
+// x = 25, where no triangle's centroid lies.
+TEST(PlanEvaluation, GroupSelectorsOfAnObjFileJudgeTheirGroupsTriangles) {
+  const Scene s = MakeScene();
+  testing::TempDir dir;
+  const std::string obj = dir.File("part.obj");
+  {
+    std::ofstream out(obj);
+    for (const auto& v : s.mesh.vertices)
+      out << "v " << v.x() << " " << v.y() << " " << v.z() << "\n";
+    for (const char* side : {"left", "right"}) {
+      out << "g " << side << "\n";
+      for (const auto& t : s.mesh.triangles) {
+        const double cx =
+            (s.mesh.vertices[t[0]].x() + s.mesh.vertices[t[1]].x() + s.mesh.vertices[t[2]].x()) / 3;
+        if ((cx < 25) == (std::string(side) == "left"))
+          out << "f " << t[0] + 1 << " " << t[1] + 1 << " " << t[2] + 1 << "\n";
+      }
+    }
+  }
+  auto part = ReadMesh(obj);
+  ASSERT_TRUE(part.ok()) << part.status();
+  auto index = MeshIndex::Build(*part);
+  ASSERT_TRUE(index.ok());
+  auto em = ComputeErrorMap(**index, s.cloud, Eigen::Isometry3d::Identity(), {});
+  ASSERT_TRUE(em.ok());
+  const auto plan_with = [&](const char* select) {
+    auto plan = ParsePlanForMeshFile(
+        nlohmann::json::parse(std::string(R"({"regions": [{"name": "left", "select": )") + select +
+                              "}]}"),
+        *part, obj, ErrorMapSettings{});
+    EXPECT_TRUE(plan.ok()) << plan.status();
+    return plan.ok() ? *plan : InspectionPlan{};
+  };
+  const InspectionPlan by_group = plan_with(R"({"group": "left"})");
+  ASSERT_EQ(by_group.regions.size(), 1u);
+  // The group is now triangle ids: a server needs no CAD file to apply it.
+  EXPECT_EQ(by_group.regions[0].select.kind, RegionSelector::Kind::kTriangles);
+  EXPECT_EQ(by_group.regions[0].select.triangles.size(), part->num_triangles() / 2);
+  const InspectionPlan by_box = plan_with(R"({"box_mm": [[0, 0, -1], [25, 50, 1]]})");
+  auto a = EvaluatePlan(*em, s.cloud, *part, by_group);
+  auto b = EvaluatePlan(*em, s.cloud, *part, by_box);
+  ASSERT_TRUE(a.ok() && b.ok());
+  const CharacteristicResult& ra = a->characteristics.characteristics[1];
+  const CharacteristicResult& rb = b->characteristics.characteristics[1];
+  EXPECT_GT(ra.points, 1000u);
+  EXPECT_EQ(ra.points, rb.points);
+  EXPECT_EQ(ra.mean_mm, rb.mean_mm);
+  EXPECT_EQ(ra.min_mm, rb.min_mm);
+
+  auto unknown = ParsePlanForMeshFile(
+      nlohmann::json::parse(R"({"regions": [{"name": "r", "select": {"group": "top"}}]})"), *part,
+      obj, ErrorMapSettings{});
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_NE(unknown.status().message().find("unknown group \"top\" (the part has 2 named groups)"),
+            std::string::npos)
+      << unknown.status();
+}
+
+}  // namespace
+}  // namespace surfinspect
