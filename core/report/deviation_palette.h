@@ -1,4 +1,4 @@
-// The error map's colour scale (core/report/error_map_output.h
+// The error map's colour scale (core/errormap/deviation_color.h
 // DeviationColor) as a 256-entry palette, so a page can colour points by a
 // one-byte index: the HTML report ships the palette and one index per point.
 //
