@@ -42,7 +42,7 @@ absl::StatusOr<std::vector<TriangleStat>> Summary(const RecordContext& c, const 
   q.max_distance_mm = c.max_distance_mm;
   ASSIGN_OR_RETURN(auto closest, QueryClosest(*c.part, world, c.world_from_part.inverse(), q));
   std::vector<uint32_t> ids(closest.size());
-  for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = (closest)[i].triangle_id;
+  for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = closest[i].triangle_id;
   return SummarizeByTriangle(ids, deviation_mm,
                              static_cast<uint32_t>(c.part->mesh().num_triangles()));
 }

@@ -39,7 +39,7 @@ absl::StatusOr<std::unique_ptr<MeshIndex>> MeshIndex::Build(TriangleMesh mesh,
   arena.execute([&] {
     try {
       index->ComputeFaceNormals();
-      bvh = index->BuildInOrder((device)->get(), settings);
+      bvh = index->BuildInOrder(device->get(), settings);
     } catch (const std::bad_alloc&) {
       bvh = absl::ResourceExhaustedError(
           absl::StrCat("mesh index: out of memory building the index of ",
@@ -47,7 +47,7 @@ absl::StatusOr<std::unique_ptr<MeshIndex>> MeshIndex::Build(TriangleMesh mesh,
     }
   });
   if (!bvh.ok()) {
-    RETURN_IF_ERROR((device)->TakeError());
+    RETURN_IF_ERROR(device->TakeError());
     return bvh.status();
   }
   index->bvh_ = std::make_unique<WideBvh>(*std::move(bvh));

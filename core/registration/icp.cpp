@@ -78,7 +78,7 @@ absl::StatusOr<Pairs> Correspond(const MeshIndex& mesh, const PointCloud& pts,
   Pairs out;
   double sum2 = 0;
   for (std::size_t i = 0; i < closest.size(); ++i) {
-    const ClosestPoint& c = (closest)[i];
+    const ClosestPoint& c = closest[i];
     if (!c.matched() || c.distance_mm > trim_at) continue;
     const Eigen::Vector3d p = pose * pts.points[i].cast<double>();
     // Inside a face the plane normal; at an edge or vertex the direction to

@@ -133,7 +133,7 @@ absl::StatusOr<std::vector<RayHit>> CastRays(const TriangleMesh& mesh_in_part,
   const Eigen::Vector3d origin = part_from_sensor.translation();
   const Pinhole camera(in);
   std::vector<RayHit> hits(std::size_t{in.width} * in.height);
-  RTCScene rtc_scene = (scene)->get();
+  RTCScene rtc_scene = scene->get();
   tbb::parallel_for(tbb::blocked_range<uint32_t>(0, in.height), [&](const auto& rows) {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
@@ -168,7 +168,7 @@ absl::StatusOr<std::vector<RayHit>> CastRays(const TriangleMesh& mesh_in_part,
         h.range = t;
       }
   });
-  RETURN_IF_ERROR((device)->TakeError());
+  RETURN_IF_ERROR(device->TakeError());
   return hits;
 }
 

@@ -102,13 +102,21 @@ TEST(Metrics, SeriesWithoutPerCallLabelsStartAtZero) {
   }
 }
 
-TEST(Metrics, RpcsAreCountedByMethodAndCode) {
-  const auto metrics = Unserved();
-  ASSERT_NE(metrics.get(), nullptr);
+// Three ErrorMap calls (OK at 3 ms and 200 ms, CANCELLED at 40 ms) and one
+// Filter (INVALID_ARGUMENT at 0.5 ms).
+std::unique_ptr<Metrics> WithFourRpcs() {
+  auto metrics = Unserved();
+  if (!metrics) return metrics;
   metrics->RecordRpc("ErrorMap", "OK", 0.003);
   metrics->RecordRpc("ErrorMap", "OK", 0.2);
   metrics->RecordRpc("ErrorMap", "CANCELLED", 0.04);
   metrics->RecordRpc("Filter", "INVALID_ARGUMENT", 0.0005);
+  return metrics;
+}
+
+TEST(Metrics, RpcsAreCountedByMethodAndCode) {
+  const auto metrics = WithFourRpcs();
+  ASSERT_NE(metrics.get(), nullptr);
   EXPECT_EQ(Sample(*metrics, R"(surfinspect_rpcs_total{code="OK",method="ErrorMap"})"), 2.0);
   EXPECT_EQ(Sample(*metrics, R"(surfinspect_rpcs_total{code="CANCELLED",method="ErrorMap"})"), 1.0);
   EXPECT_EQ(Sample(*metrics, R"(surfinspect_rpcs_total{code="INVALID_ARGUMENT",method="Filter"})"),
@@ -119,12 +127,8 @@ TEST(Metrics, RpcsAreCountedByMethodAndCode) {
 }
 
 TEST(Metrics, LatencyIsOneHistogramPerMethodOverAllCodes) {
-  const auto metrics = Unserved();
+  const auto metrics = WithFourRpcs();
   ASSERT_NE(metrics.get(), nullptr);
-  metrics->RecordRpc("ErrorMap", "OK", 0.003);
-  metrics->RecordRpc("ErrorMap", "OK", 0.2);
-  metrics->RecordRpc("ErrorMap", "CANCELLED", 0.04);
-  metrics->RecordRpc("Filter", "INVALID_ARGUMENT", 0.0005);
   EXPECT_EQ(Sample(*metrics, R"(surfinspect_rpc_duration_seconds_count{method="ErrorMap"})"), 3.0);
   EXPECT_NEAR(Sample(*metrics, R"(surfinspect_rpc_duration_seconds_sum{method="ErrorMap"})"), 0.243,
               1e-6);
