@@ -102,8 +102,8 @@ TEST(Metrics, SeriesWithoutPerCallLabelsStartAtZero) {
   }
 }
 
-// Three ErrorMap calls (OK at 3 ms and 200 ms, CANCELLED at 40 ms) and one
-// Filter (INVALID_ARGUMENT at 0.5 ms).
+// Three ErrorMap calls (OK after 0.003 s and 0.2 s, CANCELLED after 0.04 s)
+// and one Filter (INVALID_ARGUMENT after 0.0005 s).
 std::unique_ptr<Metrics> WithFourRpcs() {
   auto metrics = Unserved();
   if (!metrics) return metrics;
