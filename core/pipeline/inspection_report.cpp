@@ -248,7 +248,6 @@ json EncodeReport(const InspectionReport& report) {
 
 absl::StatusOr<InspectionReport> DecodeReport(const json& j) {
   InspectionReport report;
-  report.schema.clear();  // a report without one has none
   JsonReader r(j, "report");
   VisitReport(r, report);
   if (!r.status().ok()) return r.status();
@@ -303,7 +302,6 @@ bool ReportDefect::operator==(const ReportDefect& o) const {
 
 InspectionReport ErrorMapReport(const ErrorMapResult& r, const ErrorMapSettings& settings) {
   InspectionReport out;
-  out.schema.clear();
   out.settings = {settings.tolerance_mm, settings.max_distance_mm,
                   settings.allowed_fraction_outside, settings.histogram_bins,
                   settings.split_components};

@@ -95,8 +95,8 @@ struct ReportInputs {
 };
 
 struct InspectionReport {
-  std::string schema = kReportSchema;  // "" for an error-map report without a plan
-  std::string verdict;                 // the part verdict; "" without a plan
+  std::string schema;   // kReportSchema with a plan; "" for an error-map report alone
+  std::string verdict;  // the part verdict; "" without a plan
   ReportSettings settings;
   ErrorMapStats stats;  // point counts and the statistics of all matched points
   ReportTolerance tolerance;
