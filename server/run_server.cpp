@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <thread>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "core/io/atomic_file.h"
 #include "core/types/status_macros.h"
@@ -52,6 +53,20 @@ uint64_t MemoryBudgetBytes(const ServerOptions& options) {
 }
 
 }  // namespace
+
+std::string ExposureWarning(const ServerOptions& options) {
+  if (!options.tls_cert_file.empty() || !options.service.auth_token.empty()) return "";
+  if (absl::StartsWith(options.listen, "unix:")) return "";  // the file's permissions guard it
+  std::string host = options.listen.substr(0, options.listen.rfind(':'));
+  if (host.size() > 1 && host.front() == '[' && host.back() == ']')
+    host = host.substr(1, host.size() - 2);
+  if (host == "localhost" || host == "::1" || absl::StartsWith(host, "127.")) return "";
+  return absl::StrCat("listening on ", options.listen,
+                      " beyond loopback with neither TLS nor a token: anyone who reaches this "
+                      "port can send work and read results. Give --tls-cert/--tls-key and "
+                      "--auth-token-file, or listen on 127.0.0.1 behind a proxy "
+                      "(docs/deployment.md)");
+}
 
 absl::Status RunServer(const ServerOptions& options) {
   if (options.max_message_mb < 1 || options.max_message_mb > 2000)
@@ -115,6 +130,9 @@ absl::Status RunServer(const ServerOptions& options) {
       options.tls_cert_file.empty() ? "off" : (options.tls_client_ca_file.empty() ? "on" : "mTLS"),
       options.service.auth_token.empty() ? "off" : "on",
       options.metrics_listen.empty() ? "off" : options.metrics_listen);
+
+  if (const std::string warning = ExposureWarning(options); !warning.empty())
+    spdlog::warn("{}", warning);
 
   std::thread waiter([&] {
     int sig = 0;

@@ -30,6 +30,11 @@ struct ServerOptions {
   std::vector<std::string> fault_inject;
 };
 
+// The warning for a server that listens beyond loopback with neither TLS
+// nor a token (anyone who reaches the port can send work and read
+// results); "" when it listens on loopback only or is protected.
+std::string ExposureWarning(const ServerOptions& options);
+
 // Blocks until a shutdown signal. Prints "surfinspectd listening on
 // HOST:PORT" on stdout once serving (tests read the chosen port from it).
 absl::Status RunServer(const ServerOptions& options);

@@ -6,6 +6,7 @@
 #include "absl/strings/str_cat.h"
 #include "client/cell/part_outputs.h"
 #include "client/cell/report_context.h"
+#include "core/io/disk_space.h"
 #include "core/io/io_mesh.h"
 #include "core/io/io_point_cloud.h"
 
@@ -122,6 +123,20 @@ std::shared_ptr<const TriangleMesh> CellAgent::PartMesh() {
   return part_mesh_;
 }
 
+bool CellAgent::HasRoom() {
+  if (hooks_.disk == nullptr) return true;
+  const absl::Status room = hooks_.disk->Check();
+  SetDiskFull(room.ok() ? "" : std::string(room.message()));
+  return room.ok();
+}
+
+void CellAgent::SetDiskFull(const std::string& reason) {
+  const bool changed = reason.empty() != disk_full_.empty();
+  disk_full_ = reason;
+  if (changed)
+    for (const auto& listener : hooks_.on_disk) listener(reason);
+}
+
 void CellAgent::TellStored(const std::string& id) const {
   const std::string dir = (fs::path(layout_.results) / id).string();
   for (const auto& listener : hooks_.on_stored) listener(id, dir);
@@ -192,10 +207,15 @@ PartReport CellAgent::InspectAndStore(const std::string& id, const std::vector<V
       outputs->mesh_in_part = PartMesh();
       outputs->viewpoints = ViewpointCalibrations(cell_);
     }
-    absl::Status written =
-        outputs.ok()
-            ? WritePartOutputs((fs::path(layout_.results) / id).string(), *outputs, cell_.outputs)
-            : outputs.status();
+    uint64_t bytes = 0;
+    absl::Status written = outputs.ok()
+                               ? WritePartOutputs((fs::path(layout_.results) / id).string(),
+                                                  *outputs, cell_.outputs, &bytes)
+                               : outputs.status();
+    if (hooks_.disk != nullptr && (written.ok() || IsDiskFull(written))) {
+      written.ok() ? hooks_.disk->SetWritten(bytes) : hooks_.disk->SetFailed(bytes);
+      if (!written.ok()) SetDiskFull(std::string(written.message()));
+    }
     if (!written.ok()) {  // disk trouble: keep the part in the inbox for the next pass
       r = Report(PartOutcome::kRetryLater,
                  absl::StrCat("cannot write results: ", written.message()));
@@ -221,6 +241,7 @@ RunSummary CellAgent::Run(const std::atomic<bool>& stop,
     bool progressed = false;
     for (const auto& id : CompleteParts(layout_.inbox)) {
       if (stop.load()) break;
+      if (!HasRoom()) break;  // paused: the parts wait in the inbox
       if (hooks_.before_part)
         if (absl::Status st = hooks_.before_part(s.done); !st.ok()) {
           s.halted = std::string(st.message());
@@ -249,6 +270,7 @@ RunSummary CellAgent::Run(const std::atomic<bool>& stop,
         case PartOutcome::kStopped:
           break;
       }
+      if (!disk_full_.empty()) break;  // the part's write found the disk full
     }
     if (settings_.once && (!progressed || CompleteParts(layout_.inbox).empty())) break;
     if (!progressed && !stop.load()) hooks_.sleep(settings_.poll_s, stop);

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "client/agent/disk_guard.h"
 #include "client/agent/inbox.h"
 #include "client/agent/retry.h"
 #include "client/cell/cell_config.h"
@@ -98,6 +99,12 @@ struct AgentHooks {
   // A non-OK answer stops Run: that part and the rest stay in the inbox, and
   // RunSummary::halted carries the message.
   std::function<absl::Status(int parts_done)> before_part;
+  // Asked before each part whether its results have room; null = always.
+  // While they have none, Run takes no part (they stay in the inbox).
+  DiskGuard* disk = nullptr;
+  // Told once per change: the reason when the agent pauses for lack of
+  // space, "" when it resumes.
+  std::vector<std::function<void(const std::string& reason)>> on_disk;
 };
 
 class CellAgent {
@@ -124,6 +131,9 @@ class CellAgent {
   PartReport InspectAndStore(const std::string& id, const std::vector<ViewScan>& views,
                              const std::atomic<bool>& stop);
   void TellStored(const std::string& id) const;
+  // Whether the next part's results have room; tells a change of state.
+  bool HasRoom();
+  void SetDiskFull(const std::string& reason);  // "" = room again
   // The part's CAD mesh for the reports' overlay, read once on first use;
   // null when it cannot be read (the reports then go without the overlay).
   std::shared_ptr<const TriangleMesh> PartMesh();
@@ -137,6 +147,7 @@ class CellAgent {
   std::map<std::string, std::string> quarantine_pending_;
   std::shared_ptr<const TriangleMesh> part_mesh_;
   bool part_mesh_read_ = false;
+  std::string disk_full_;  // why the agent pauses; "" = it does not
 };
 
 }  // namespace surfinspect::client

@@ -8,6 +8,8 @@
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
+#include "client/agent/retention.h"
 #include "client/agent/simulated_robot.h"
 #include "client/agent/store_recorder.h"
 #include "client/cell/cell_config.h"
@@ -44,11 +46,32 @@ absl::StatusOr<std::unique_ptr<RemoteClient>> ConnectFor(const AgentArgs& a,
   return RemoteClient::Connect(o);
 }
 
+// Whether the server answered last time asked, told once per change.
+struct ServerWatch {
+  bool unreachable = false;
+
+  // The server's answer to a health check that does not wait (OK or
+  // Unavailable "cannot reach surfinspectd at ...": retried with backoff).
+  absl::Status Ask(RemoteClient& client, const AgentOutput& out) {
+    absl::Status st = client.WaitUntilReachable(0);
+    if (!st.ok() && !unreachable)
+      Tell(out.warn,
+           absl::StrCat("waiting for the server (", st.message(), "); parts wait in the inbox"));
+    if (st.ok() && unreachable)
+      Tell(out.info, absl::StrCat("surfinspectd at ", client.target(), " answers; going on"));
+    unreachable = !st.ok();
+    return st;
+  }
+};
+
 // Streams a part with the cell's inspection plan, telling its progress.
 InspectFn InspectOver(RemoteClient& client, const TriangleMesh& part,
-                      const std::optional<InspectionPlan>& plan, const AgentOutput& out) {
-  return [&client, &part, &plan, &out](const v1::PartHeader& part_header,
-                                       const std::vector<ViewScan>& views) {
+                      const std::optional<InspectionPlan>& plan, const AgentOutput& out,
+                      ServerWatch& watch) {
+  return [&client, &part, &plan, &out, &watch](
+             const v1::PartHeader& part_header,
+             const std::vector<ViewScan>& views) -> absl::StatusOr<v1::InspectResult> {
+    RETURN_IF_ERROR(watch.Ask(client, out));
     v1::PartHeader header = part_header;
     if (plan) wire::PlanToProto(*plan, header.mutable_plan());
     return client.Inspect(header, part, views, [&](const v1::Progress& p) {
@@ -156,6 +179,70 @@ absl::Status StartDriftChecks(const AgentArgs& a, const CellConfig& cell, const 
   return absl::OkStatus();
 }
 
+// The disk guard and the retention rule of a running agent.
+struct Housekeeping {
+  std::unique_ptr<DiskGuard> disk;
+  RetentionConfig retention;
+  std::string status_dir, cell;
+  int unsettled = 0;  // parts due for pruning that wait for the store or the broker
+};
+
+void WriteDiskMetrics(const Housekeeping& h, bool full, const AgentOutput& out) {
+  const std::string path = h.status_dir + "/agent_status.prom";
+  if (absl::Status st = WriteStringAtomically(path, DiskMetrics(h.cell, full, h.disk->Space()));
+      !st.ok())
+    Tell(out.warn, absl::StrCat("cannot write ", path, ": ", st.message()));
+}
+
+// Clears interrupted sets, and reads the disk and retention settings.
+absl::Status StartHousekeeping(const AgentArgs& a, const CellConfig& cell,
+                               const InboxLayout& layout, const AgentOutput& out, Housekeeping& h) {
+  ASSIGN_OR_RETURN(const std::vector<std::string> leftovers, RemoveUnfinishedSets(layout.results));
+  if (!leftovers.empty())
+    Tell(out.warn, absl::StrCat("removed ", leftovers.size(), " unfinished result sets (",
+                                absl::StrJoin(leftovers, ", "),
+                                "): their parts are in the inbox and are inspected again"));
+  ASSIGN_OR_RETURN(const DiskConfig disk, DiskConfigOf(cell));
+  ASSIGN_OR_RETURN(h.retention, RetentionConfigOf(cell));
+  std::vector<std::string> folders = {layout.results, layout.archive};
+  const std::string db = a.db.empty() ? layout.results + "/results.db" : a.db;
+  if (a.db != "none" && RedactDatabaseUrl(db) == db && db.find("://") == std::string::npos)
+    folders.push_back(std::filesystem::path(db).parent_path().string());
+  h.disk = std::make_unique<DiskGuard>(std::move(folders), disk);
+  h.status_dir = StatusDir(a);
+  h.cell = cell.name;
+  WriteDiskMetrics(h, false, out);
+  return absl::OkStatus();
+}
+
+// The disk guard's listeners: one log line per change, the metrics file.
+void WatchDisk(Housekeeping& h, const AgentOutput& out, AgentHooks& hooks) {
+  hooks.disk = h.disk.get();
+  hooks.on_disk.push_back([&h, &out](const std::string& reason) {
+    if (!reason.empty())
+      Tell(out.error, absl::StrCat(reason, "; parts wait in the inbox until space returns"));
+    else
+      Tell(out.info, "disk space is back; taking parts again");
+    WriteDiskMetrics(h, !reason.empty(), out);
+  });
+}
+
+// Applies the retention rule after a part, telling what it pruned, and how
+// many parts wait to be recorded or delivered when that number changes.
+void PruneAfterPart(Housekeeping& h, const InboxLayout& layout, const SettledFn& settled,
+                    const AgentOutput& out) {
+  if (!h.retention.any()) return;
+  const absl::StatusOr<PruneResult> r =
+      Prune(layout, h.retention, settled, std::chrono::system_clock::now());
+  if (!r.ok()) {
+    Tell(out.warn, absl::StrCat("retention: ", r.status().message()));
+    return;
+  }
+  if (r->heavy + r->light + r->archive > 0 || r->unsettled != h.unsettled)
+    Tell(out.info, absl::StrCat("retention: ", PruneText(*r)));
+  h.unsettled = r->unsettled;
+}
+
 }  // namespace
 
 std::string StatusDir(const AgentArgs& a) {
@@ -199,6 +286,46 @@ absl::StatusOr<CellVerification> RunVerifyCommand(const AgentArgs& a, const Agen
   return VerifyAndReport(a, cell, *index, GaugeScans(a, cell, gauge, drift), config.limits, out);
 }
 
+namespace {
+
+// --simulate: drops simulated parts into the inbox first.
+absl::Status SimulateIfAsked(const AgentArgs& a, const CellConfig& cell, const InboxLayout& layout,
+                             const RobotDrift& drift, const AgentOutput& out) {
+  if (a.simulate <= 0) return absl::OkStatus();
+  SurfaceDrift surface;
+  if (!a.drift.empty()) {
+    ASSIGN_OR_RETURN(surface, ParseSurfaceDrift(a.drift));
+  }
+  ASSIGN_OR_RETURN(const auto ids,
+                   SimulateParts(cell, layout.inbox, a.simulate, a.seed, surface, drift));
+  Tell(out.info,
+       absl::StrCat("simulated robot: ", ids.size(), " parts dropped into ", layout.inbox));
+  return absl::OkStatus();
+}
+
+// The listeners of plant events and of the results store.
+void Listen(MqttPublisher* mqtt, StoreRecorder* recorder, AgentHooks& hooks) {
+  if (mqtt) {
+    hooks.on_started.push_back([mqtt](const std::string& id) { mqtt->OnStarted(id); });
+    hooks.on_stored.push_back(
+        [mqtt](const std::string& id, const std::string& dir) { mqtt->OnStored(id, dir); });
+    hooks.on_disk.push_back([mqtt](const std::string& reason) { mqtt->DiskFull(reason); });
+  }
+  if (recorder)
+    hooks.on_stored.push_back(
+        [recorder](const std::string& id, const std::string& dir) { recorder->OnStored(id, dir); });
+}
+
+// A results folder may be pruned once the store and the broker have it.
+SettledFn SettledBy(const InboxLayout& layout, const StoreRecorder* recorder, bool mqtt) {
+  return [&layout, recorder, mqtt](const std::string& id) {
+    if (recorder && recorder->behind()) return false;
+    return !mqtt || MqttDelivered((std::filesystem::path(layout.results) / id).string());
+  };
+}
+
+}  // namespace
+
 absl::StatusOr<RunOutcome> RunCellCommand(const AgentArgs& a, const AgentOutput& out,
                                           std::atomic<bool>& stop) {
   ASSIGN_OR_RETURN(const CellConfig cell, ReadCellConfig(a.cell));
@@ -207,55 +334,63 @@ absl::StatusOr<RunOutcome> RunCellCommand(const AgentArgs& a, const AgentOutput&
   RETURN_IF_ERROR(PrepareDirectories(layout));
   Tell(out.info, absl::StrCat("inbox ", layout.inbox, ", results ", layout.results, ", archive ",
                               layout.archive, ", quarantine ", layout.quarantine));
+  Housekeeping housekeeping;
+  RETURN_IF_ERROR(StartHousekeeping(a, cell, layout, out, housekeeping));
   ASSIGN_OR_RETURN(const RobotDrift drift, RobotDriftOf(a));
-  if (a.simulate > 0) {
-    SurfaceDrift surface;
-    if (!a.drift.empty()) {
-      ASSIGN_OR_RETURN(surface, ParseSurfaceDrift(a.drift));
-    }
-    ASSIGN_OR_RETURN(const auto ids,
-                     SimulateParts(cell, layout.inbox, a.simulate, a.seed, surface, drift));
-    Tell(out.info,
-         absl::StrCat("simulated robot: ", ids.size(), " parts dropped into ", layout.inbox));
-  }
+  RETURN_IF_ERROR(SimulateIfAsked(a, cell, layout, drift, out));
   ASSIGN_OR_RETURN(const TriangleMesh part, ReadMesh(cell.part_mesh));
   ASSIGN_OR_RETURN(const std::optional<InspectionPlan> plan, PlanOf(cell, part, cell.error_map));
   ASSIGN_OR_RETURN(const std::unique_ptr<RemoteClient> client, ConnectFor(a, cell));
+  ServerWatch watch;
+  (void)watch.Ask(*client, out);  // says at start when the server is not there yet
   ASSIGN_OR_RETURN(const std::unique_ptr<MqttPublisher> mqtt, StartMqtt(a, cell, layout, out));
   AgentHooks hooks;
-  hooks.inspect = InspectOver(*client, part, plan, out);
-  if (mqtt) {
-    hooks.on_started.push_back([&mqtt](const std::string& id) { mqtt->OnStarted(id); });
-    hooks.on_stored.push_back(
-        [&mqtt](const std::string& id, const std::string& dir) { mqtt->OnStored(id, dir); });
-  }
-  hooks.on_retry = [&out](const std::string& id, const absl::Status& st, int calls, double) {
-    Tell(out.warn, absl::StrCat(id, ": ", st.message(), " (attempt ", calls, ", retrying)"));
+  hooks.inspect = InspectOver(*client, part, plan, out, watch);
+  hooks.on_retry = [&out, &watch](const std::string& id, const absl::Status& st, int calls,
+                                  double) {
+    if (!watch.unreachable)  // said once by the watch
+      Tell(out.warn, absl::StrCat(id, ": ", st.message(), " (attempt ", calls, ", retrying)"));
   };
+  WatchDisk(housekeeping, out, hooks);
   DriftChecks checks;
   RETURN_IF_ERROR(StartDriftChecks(a, cell, drift, out, checks));
   if (checks.monitor)
     hooks.before_part = [&checks](int done) { return checks.monitor->BeforePart(done); };
   ASSIGN_OR_RETURN(const std::unique_ptr<StoreRecorder> recorder,
                    MakeRecorder(a, cell, layout, part, out));
-  if (recorder)
-    hooks.on_stored.push_back([&recorder](const std::string& id, const std::string& dir) {
-      recorder->OnStored(id, dir);
-    });
+  Listen(mqtt.get(), recorder.get(), hooks);
+  const SettledFn settled = SettledBy(layout, recorder.get(), mqtt != nullptr);
   AgentSettings settings;
   settings.backoff = a.backoff;
   settings.poll_s = a.poll_s;
   settings.once = a.once;
   CellAgent agent(cell, layout, settings, std::move(hooks),
                   a.seed ^ static_cast<uint64_t>(::getpid()));
-  outcome.summary = agent.Run(stop, [&mqtt, &out](const PartReport& r) {
+  outcome.summary = agent.Run(stop, [&](const PartReport& r) {
     if (out.part) out.part(r);
     if (mqtt && r.outcome == PartOutcome::kConfigError) mqtt->CalibrationExpired(r.message);
+    if (r.outcome == PartOutcome::kDone) PruneAfterPart(housekeeping, layout, settled, out);
   });
   // A failed drift check makes the calibration unusable, as a missing one does.
   if (mqtt && !outcome.summary.halted.empty()) mqtt->CalibrationExpired(outcome.summary.halted);
   if (mqtt) mqtt->Stop();
   return outcome;
+}
+
+absl::StatusOr<PruneResult> RunPruneCommand(const AgentArgs& a, const AgentOutput& out) {
+  ASSIGN_OR_RETURN(const CellConfig cell, ReadCellConfig(a.cell));
+  ASSIGN_OR_RETURN(const RetentionConfig rule, RetentionConfigOf(cell));
+  if (!rule.any())
+    return absl::FailedPreconditionError(
+        absl::StrCat(cell.path, ": no \"retention\" rule, nothing to prune (docs/cell-agent.md)"));
+  const InboxLayout layout = ResolveLayout(a.paths);
+  ASSIGN_OR_RETURN(const TriangleMesh part, ReadMesh(cell.part_mesh));
+  ASSIGN_OR_RETURN(const std::unique_ptr<StoreRecorder> recorder,
+                   MakeRecorder(a, cell, layout, part, out));
+  ASSIGN_OR_RETURN(const MqttSettings mqtt, MqttSettingsFromCell(cell));
+  const bool mqtt_on = !a.mqtt.url.empty() || !mqtt.url.empty();
+  return Prune(layout, rule, SettledBy(layout, recorder.get(), mqtt_on),
+               std::chrono::system_clock::now());
 }
 
 }  // namespace surfinspect::client

@@ -15,6 +15,7 @@
 #include "client/agent/agent.h"
 #include "client/agent/agent_flags.h"
 #include "client/agent/calibrate_cell.h"
+#include "client/agent/retention.h"
 #include "client/agent/verify_cell.h"
 
 namespace surfinspect::client {
@@ -47,5 +48,10 @@ struct RunOutcome {
 };
 absl::StatusOr<RunOutcome> RunCellCommand(const AgentArgs& args, const AgentOutput& out,
                                           std::atomic<bool>& stop);
+
+// cell.json's "retention" rule, applied once: the results store is caught
+// up first, and a results folder is pruned only when the store (and the
+// broker, where the cell has one) has the part.
+absl::StatusOr<PruneResult> RunPruneCommand(const AgentArgs& args, const AgentOutput& out);
 
 }  // namespace surfinspect::client

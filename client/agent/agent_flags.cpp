@@ -76,6 +76,22 @@ void AddVerifyOptions(CLI::App* cmd, AgentArgs& a) {
                   "where calibration_status.json/.prom go (default: beside cell.json)");
 }
 
+// prune: the folders and the listeners whose records a prune waits for.
+void AddPruneOptions(CLI::App* cmd, AgentArgs& a) {
+  AgentPaths& p = a.paths;
+  cmd->add_option("--cell", a.cell, "cell.json (its \"retention\" rule)")->required();
+  cmd->add_option("--cell-dir", p.cell_dir, "default parent of inbox/, results/ and archive/");
+  cmd->add_option("--inbox", p.inbox, "the inbox (default: inbox); archive/ defaults beside it");
+  cmd->add_option("--results", p.results, "results/<part-id>/ (default: results)");
+  cmd->add_option("--archive", p.archive, "processed scans (default: beside the inbox)");
+  cmd->add_option("--db", a.db,
+                  "results store whose records a prune waits for; default RESULTS/results.db; "
+                  "none = off")
+      ->envname("SURFINSPECT_DB");
+  cmd->add_option("--mqtt", a.mqtt.url,
+                  "the broker whose deliveries a prune waits for (default: mqtt.url in cell.json)");
+}
+
 }  // namespace
 
 AgentCommands AddAgentCommands(CLI::App& app, AgentArgs& a) {
@@ -100,6 +116,9 @@ AgentCommands AddAgentCommands(CLI::App& app, AgentArgs& a) {
                        "folder of fresh <viewpoint>.pcd (default: the simulated robot scans)");
   c.verify->add_option("--seed", a.seed, "random seed (simulated robot)");
   AddVerifyOptions(c.verify, a);
+  c.prune = app.add_subcommand(
+      "prune", "Apply cell.json's \"retention\" rule now (the running agent applies it too)");
+  AddPruneOptions(c.prune, a);
   return c;
 }
 

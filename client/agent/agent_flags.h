@@ -33,9 +33,10 @@ struct AgentCommands {
   CLI::App* calibrate = nullptr;
   CLI::App* run = nullptr;
   CLI::App* verify = nullptr;
+  CLI::App* prune = nullptr;
 };
 
-// The three subcommands and their flags, filling `args`.
+// The four subcommands and their flags, filling `args`.
 AgentCommands AddAgentCommands(CLI::App& app, AgentArgs& args);
 
 }  // namespace surfinspect::client

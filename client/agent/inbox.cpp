@@ -5,6 +5,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/io/atomic_file.h"
+#include "core/io/staged_folder.h"
+#include "core/types/status_macros.h"
 
 namespace surfinspect::client {
 namespace fs = std::filesystem;
@@ -30,6 +32,26 @@ std::vector<std::string> CompleteParts(const std::string& inbox) {
 
 bool HasResults(const InboxLayout& layout, const std::string& id) {
   return fs::exists(fs::path(layout.results) / id / "report.json");
+}
+
+absl::StatusOr<std::vector<std::string>> RemoveUnfinishedSets(const std::string& results) {
+  ASSIGN_OR_RETURN(std::vector<std::string> removed, RemoveStagingLeftovers(results));
+  std::vector<fs::path> unfinished;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(results, ec)) {
+    const std::string name = e.path().filename().string();
+    if (!name.empty() && name[0] != '.' && e.is_directory() &&
+        !fs::exists(e.path() / "report.json"))
+      unfinished.push_back(e.path());
+  }
+  for (const fs::path& p : unfinished) {
+    fs::remove_all(p, ec);
+    if (ec)
+      return absl::PermissionDeniedError(
+          absl::StrCat("cannot remove ", p.string(), ": ", ec.message()));
+    removed.push_back(p.filename().string());
+  }
+  return removed;
 }
 
 absl::Status MovePart(const std::string& inbox, const std::string& dest, const std::string& id) {

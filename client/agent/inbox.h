@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "absl/status/status.h"
+#include "absl/status/statusor.h"
 
 namespace surfinspect::client {
 
@@ -23,6 +23,12 @@ std::vector<std::string> CompleteParts(const std::string& inbox);
 bool IsValidPartId(const std::string& id);
 // Results already on disk (report.json is written last).
 bool HasResults(const InboxLayout& layout, const std::string& part_id);
+// Sets whose writing a crash or a kill interrupted: RESULTS/.partial/*
+// (client/cell/part_files.h stages each set there) and, from versions that
+// wrote in place, part folders without report.json. Removes them and
+// returns their names; their parts are still in the inbox and are
+// inspected again. Only for the one agent that owns RESULTS.
+absl::StatusOr<std::vector<std::string>> RemoveUnfinishedSets(const std::string& results);
 // Moves INBOX/<id> to DEST/<id> (DEST/<id>.N if taken).
 absl::Status MovePart(const std::string& inbox, const std::string& dest, const std::string& id);
 absl::Status Quarantine(const InboxLayout& layout, const std::string& id, const std::string& why);

@@ -2,8 +2,9 @@
 // gauge scan on the service and stores the results in cell.json; `run`
 // watches the inbox, streams each complete part to Inspect, writes the
 // results, and archives the scans; `verify` checks the calibration for
-// drift. What each command does is client/agent/agent_command.h; this file
-// holds the signals, the printing and the exit codes.
+// drift; `prune` applies the retention rule. What each command does is
+// client/agent/agent_command.h; this file holds the signals, the printing
+// and the exit codes.
 #include <signal.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
@@ -140,6 +141,13 @@ int Run(const AgentArgs& a) {
   return s.quarantined == 0 ? 0 : 3;
 }
 
+int Prune(const AgentArgs& a) {
+  const auto r = RunPruneCommand(a, Printing());
+  if (Failed(r)) return 2;
+  std::printf("%s\n", PruneText(*r).c_str());
+  return 0;
+}
+
 }  // namespace
 }  // namespace surfinspect::client
 
@@ -155,5 +163,6 @@ int main(int argc, char** argv) {
   signal(SIGINT, OnSignal);
   if (commands.calibrate->parsed()) return Calibrate(a);
   if (commands.verify->parsed()) return Verify(a);
+  if (commands.prune->parsed()) return Prune(a);
   return Run(a);
 }

@@ -6,7 +6,8 @@
 //   PREFIX/<cell>/<part>/started   a part's scans were read; it is being inspected
 //   PREFIX/<cell>/<part>/result    its results are on disk (verdict, failures, files)
 //   PREFIX/<cell>/status           retained: online, offline (the Last Will, or a clean
-//                                  stop), calibration_expired (a viewpoint cannot be used)
+//                                  stop), calibration_expired (a viewpoint cannot be used),
+//                                  disk_full (parts wait in the inbox until space returns)
 // Delivery is QoS 1: a message may arrive twice, so each carries the part id
 // and an idempotency key that is the same for every copy of one event.
 #pragma once
@@ -66,7 +67,7 @@ std::string StartedPayload(const std::string& cell, const std::string& part_id,
 absl::StatusOr<std::string> ResultPayload(const std::string& cell, const std::string& part_id,
                                           const std::string& results_dir,
                                           const std::string& report_json, const std::string& time);
-// state: "online", "offline" or "calibration_expired"; reason may be empty.
+// state: "online", "offline", "calibration_expired" or "disk_full"; reason may be empty.
 std::string StatusPayload(const std::string& cell, const std::string& state,
                           const std::string& reason, const std::string& time);
 

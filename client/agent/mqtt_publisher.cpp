@@ -41,6 +41,7 @@ struct MqttPublisher::State {
   int refused_logged = -1;  // the last CONNACK refusal logged (logged once per code)
   std::string expired_reason;
   bool calibration_expired = false;
+  std::string disk_full_reason;          // "" = not full
   std::deque<Message> queue;             // not yet handed to libmosquitto
   std::map<int, std::string> inflight;   // message id -> mark
   std::set<std::string> results_queued;  // parts whose result this process queued
@@ -65,6 +66,13 @@ struct MqttPublisher::State {
 
   std::string StatusNow(const std::string& state, const std::string& reason) const {
     return StatusPayload(cell, state, reason, EventTimeNow());
+  }
+
+  // The retained status while connected (mu held).
+  std::string StatusHeld() const {
+    if (calibration_expired) return StatusNow("calibration_expired", expired_reason);
+    if (!disk_full_reason.empty()) return StatusNow("disk_full", disk_full_reason);
+    return StatusNow("online", "");
   }
 };
 
@@ -91,11 +99,7 @@ void OnConnect(mosquitto*, void* obj, int rc) {
          absl::StrCat("mqtt: connected to ", s->url, " as ", ClientIdOf(s->settings, s->cell), "; ",
                       s->queue.size(), " events queued"));
   // The retained status first, then what waited.
-  s->queue.push_front({StatusTopic(s->settings, s->cell),
-                       s->calibration_expired
-                           ? s->StatusNow("calibration_expired", s->expired_reason)
-                           : s->StatusNow("online", ""),
-                       true, ""});
+  s->queue.push_front({StatusTopic(s->settings, s->cell), s->StatusHeld(), true, ""});
   s->Flush();
   s->cv.notify_all();
 }
@@ -272,6 +276,20 @@ void MqttPublisher::CalibrationExpired(const std::string& reason) {
   }
   Enqueue(StatusTopic(state_->settings, state_->cell),
           state_->StatusNow("calibration_expired", reason), true, "");
+}
+
+void MqttPublisher::DiskFull(const std::string& reason) {
+  std::string status;
+  {
+    std::lock_guard<std::mutex> lock(state_->mu);
+    state_->disk_full_reason = reason;
+    status = state_->StatusHeld();
+  }
+  Enqueue(StatusTopic(state_->settings, state_->cell), std::move(status), true, "");
+}
+
+bool MqttDelivered(const std::string& part_results_dir) {
+  return fs::exists(fs::path(part_results_dir) / kDeliveredMark);
 }
 
 void MqttPublisher::Stop(double flush_s) {

@@ -13,8 +13,8 @@
 //
 // The retained status topic says "online" on every connection, "offline"
 // through the Last Will when the agent dies (within ~1.5 keep-alives) or on
-// Stop, and "calibration_expired" when the agent stops on an unusable
-// viewpoint calibration.
+// Stop, "calibration_expired" when the agent stops on an unusable
+// viewpoint calibration, and "disk_full" while it pauses for lack of space.
 #pragma once
 
 #include <functional>
@@ -53,6 +53,10 @@ class MqttPublisher {
   void OnStored(const std::string& part_id, const std::string& part_results_dir);
   // Retained status "calibration_expired" with the reason; kept at Stop.
   void CalibrationExpired(const std::string& reason);
+  // Retained status "disk_full" with the reason while the agent pauses for
+  // lack of space (`reason` non-empty), "online" again when it resumes ("").
+  // calibration_expired wins over it.
+  void DiskFull(const std::string& reason);
 
   // Publishes the retained "offline" status (unless calibration_expired was
   // set), waits up to `flush_s` for queued messages to be acknowledged,
@@ -70,5 +74,8 @@ class MqttPublisher {
 
   std::unique_ptr<State> state_;
 };
+
+// Whether RESULTS/<part>/'s result event was acknowledged by the broker.
+bool MqttDelivered(const std::string& part_results_dir);
 
 }  // namespace surfinspect::client

@@ -6,6 +6,8 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "core/io/atomic_file.h"
+#include "core/io/disk_space.h"
+#include "core/io/staged_folder.h"
 #include "core/report/error_map_output.h"
 #include "core/report/html_report.h"
 #include "core/report/pdf_report.h"
@@ -16,15 +18,16 @@ namespace {
 
 constexpr std::array<PartFileEntry, kPartFileCount> kCatalogue = {{
     {PartFile::kReport, "report", "report.json",
-     "the verdict, statistics, characteristics and defects (always written, last)", true},
+     "the verdict, statistics, characteristics and defects (always written, last)", true, false},
     {PartFile::kPly, "ply", "errormap.ply",
-     "every point with its deviation and colour (CloudCompare, MeshLab)", true},
-    {PartFile::kCsv, "csv", "deviations.csv", "one row per point: x, y, z, deviation", false},
-    {PartFile::kPng, "png", "errormap.png", "the coloured map with its legend and histogram", true},
-    {PartFile::kPdf, "pdf", "report.pdf", "the printable report for the quality file", true},
+     "every point with its deviation and colour (CloudCompare, MeshLab)", true, true},
+    {PartFile::kCsv, "csv", "deviations.csv", "one row per point: x, y, z, deviation", false, true},
+    {PartFile::kPng, "png", "errormap.png", "the coloured map with its legend and histogram", true,
+     false},
+    {PartFile::kPdf, "pdf", "report.pdf", "the printable report for the quality file", true, false},
     {PartFile::kHtml, "html", "report.html", "the interactive 3D report, one self-contained page",
-     true},
-    {PartFile::kQif, "qif", "result.qif", "QIF 3.0 Results for quality systems", true},
+     true, true},
+    {PartFile::kQif, "qif", "result.qif", "QIF 3.0 Results for quality systems", true, false},
 }};
 
 absl::Status Need(bool present, const char* what, PartFile file) {
@@ -153,17 +156,29 @@ absl::Status WritePartFile(PartFile file, const std::string& path, const PartFil
   return absl::InternalError("unknown part file");
 }
 
-absl::Status WritePartFiles(const std::string& dir, const PartFileSet& set,
-                            const PartFileInputs& in) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) return absl::PermissionDeniedError(absl::StrCat(dir, ": ", ec.message()));
+namespace {
+
+// The files of `set` into `dir`, report.json last.
+absl::Status WriteEach(const std::string& dir, const PartFileSet& set, const PartFileInputs& in) {
   for (const PartFileEntry& e : kCatalogue)
     if (e.file != PartFile::kReport && set.Has(e.file))
       RETURN_IF_ERROR(WritePartFile(e.file, absl::StrCat(dir, "/", e.file_name), in));
-  // The report last: its presence means the part's results are complete.
   return WritePartFile(PartFile::kReport,
                        absl::StrCat(dir, "/", EntryOf(PartFile::kReport).file_name), in);
+}
+
+}  // namespace
+
+absl::Status WritePartFiles(const std::string& dir, const PartFileSet& set,
+                            const PartFileInputs& in, uint64_t* bytes) {
+  if (bytes != nullptr) *bytes = 0;
+  absl::StatusOr<StagedFolder> staged = StagedFolder::Begin(dir);
+  if (!staged.ok()) return AsDiskFull(staged.status(), dir);
+  absl::Status st = WriteEach(staged->path(), set, in);
+  if (bytes != nullptr) *bytes = staged->Bytes();
+  if (st.ok()) st = staged->Commit(EntryOf(PartFile::kReport).file_name);
+  // Told before the staged files go, while a full disk is still full.
+  return AsDiskFull(st, dir);
 }
 
 }  // namespace surfinspect::client

@@ -35,6 +35,9 @@ struct PartFileEntry {
   const char* file_name;  // in a part's results folder
   const char* what;       // one line, for help texts
   bool by_default;
+  // Heavy files grow with the points (the PLY, the CSV, the HTML with its
+  // embedded cloud): retention prunes them first (client/agent/retention.h).
+  bool heavy;
 };
 
 // Every entry, report.json first (it is written last: its presence means the
@@ -90,9 +93,13 @@ struct PartFileInputs {
 // surfinspect.report/2 only (a report from an older server has no plan).
 absl::Status WritePartFile(PartFile file, const std::string& path, const PartFileInputs& in);
 
-// The files of `set` into `dir` under their catalogue names, report.json
-// last.
+// The files of `set` into `dir` under their catalogue names, as one whole
+// set: written into a staging folder (core/io/staged_folder.h), report.json
+// last, then renamed into place, so a failure, a kill or a full disk leaves
+// no file of this set. A full disk is ResourceExhausted (core/io/
+// disk_space.h: IsDiskFull). `bytes`, when given, receives the set's size;
+// on a failure, what had been written before it.
 absl::Status WritePartFiles(const std::string& dir, const PartFileSet& set,
-                            const PartFileInputs& in);
+                            const PartFileInputs& in, uint64_t* bytes = nullptr);
 
 }  // namespace surfinspect::client

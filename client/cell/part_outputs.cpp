@@ -114,7 +114,7 @@ v1::PartHeader MakePartHeader(const std::string& part_id, const Eigen::Isometry3
 }
 
 absl::Status WritePartOutputs(const std::string& dir, const PartOutputs& o,
-                              const PartFileSet& files) {
+                              const PartFileSet& files, uint64_t* bytes) {
   ASSIGN_OR_RETURN(const InspectionReport report, ParseReport(o.report_json));
   // The PLY/CSV writers only read deviations, tolerance and colour range.
   ErrorMapResult view;
@@ -136,7 +136,7 @@ absl::Status WritePartOutputs(const std::string& dir, const PartOutputs& o,
   in.mesh_in_part = o.mesh_in_part.get();
   in.viewpoints = o.viewpoints;
   in.qif = QifContextOf(o);
-  return WritePartFiles(dir, files, in);
+  return WritePartFiles(dir, files, in, bytes);
 }
 
 }  // namespace surfinspect::client

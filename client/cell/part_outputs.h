@@ -1,7 +1,7 @@
 // An inspected part's results, the same whether it was computed in-process
 // or by surfinspectd, and its files in a results folder: the catalogue's
 // (client/cell/part_files.h) that the cell asks for, the PLY in the world
-// frame, the pictures in the part frame, each written atomically and
+// frame, the pictures in the part frame, written as one whole set with
 // report.json last.
 #pragma once
 
@@ -55,7 +55,9 @@ absl::StatusOr<PartOutputs> OutputsFromRemote(const ::surfinspect::v1::InspectRe
                                              const Eigen::Isometry3d& world_from_part,
                                              const InspectionSettings& settings);
 
+// The part's files as one whole set (WritePartFiles); `bytes` as there.
 absl::Status WritePartOutputs(const std::string& dir, const PartOutputs& outputs,
-                              const PartFileSet& files = PartFileSet::Defaults());
+                              const PartFileSet& files = PartFileSet::Defaults(),
+                              uint64_t* bytes = nullptr);
 
 }  // namespace surfinspect::client

@@ -27,6 +27,14 @@ struct InspectArgs {
   RemoteArgs remote;
 };
 
+// "scans/part-001/" and "scans/part-001" both name part-001 (shell
+// completion writes the slash).
+std::string FolderName(const std::string& path) {
+  std::filesystem::path p = std::filesystem::path(path).lexically_normal();
+  if (p.filename().empty()) p = p.parent_path();
+  return p.filename() == "." || p.filename() == ".." ? "" : p.filename().string();
+}
+
 // Records the part from the files just written (client/cell/part_recorder.h).
 void Record(ResultsStore& store, const InspectArgs& a, const client::CellConfig& cell,
             const TriangleMesh& part, const std::string& part_id) {
@@ -66,8 +74,11 @@ void Inspect(const InspectArgs& a) {
     views.push_back({vp.name, Take(ReadPointCloud(path)), *vp.world_from_sensor});
   }
   if (views.empty()) throw CommandFailed(a.scans + ": no <viewpoint>.pcd scans for this cell");
-  const std::string part_id =
-      a.part_id.empty() ? std::filesystem::path(a.scans).filename().string() : a.part_id;
+  const std::string part_id = a.part_id.empty() ? FolderName(a.scans) : a.part_id;
+  if (part_id.empty())
+    throw CommandFailed(a.scans +
+                        ": no folder name to take the part id from; "
+                        "give --part-id");
   client::PartOutputs outputs;
   if (a.remote.remote()) {
     const v1::PartHeader header = client::MakePartHeader(part_id, cell.world_from_part, settings);

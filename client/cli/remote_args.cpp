@@ -1,5 +1,7 @@
 #include "client/cli/remote_args.h"
 
+#include <spdlog/spdlog.h>
+
 #include "absl/strings/ascii.h"
 #include "client/cli/commands.h"
 #include "core/io/atomic_file.h"
@@ -20,6 +22,10 @@ void AddRemoteOptions(CLI::App* cmd, RemoteArgs& a) {
       ->envname("SURFINSPECT_TOKEN_FILE");
   cmd->add_option("--timeout", a.timeout_s, "per-call deadline, seconds")
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--wait-for-server", a.wait_for_server_s,
+                  "wait up to this long for the server to answer, seconds (default 0: fail at "
+                  "once when it refuses, after 3 s when it is silent)")
+      ->check(CLI::NonNegativeNumber);
 }
 
 std::unique_ptr<client::RemoteClient> Connect(const RemoteArgs& a) {
@@ -33,7 +39,12 @@ std::unique_ptr<client::RemoteClient> Connect(const RemoteArgs& a) {
   if (!a.token_file.empty())
     o.auth_token =
         std::string(absl::StripAsciiWhitespace(Take(ReadFileToString(a.token_file, 4096))));
-  return Take(client::RemoteClient::Connect(o));
+  std::unique_ptr<client::RemoteClient> client = Take(client::RemoteClient::Connect(o));
+  Check(client->WaitUntilReachable(a.wait_for_server_s, [&a](const std::string& why) {
+    spdlog::info("waiting up to {} s for surfinspectd at {} ({})", a.wait_for_server_s, a.server,
+                 why);
+  }));
+  return client;
 }
 
 }  // namespace surfinspect::cli

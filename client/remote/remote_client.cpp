@@ -3,6 +3,7 @@
 #include <grpcpp/health_check_service_interface.h>
 
 #include <chrono>
+#include <thread>
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
@@ -52,6 +53,9 @@ absl::StatusOr<std::unique_ptr<RemoteClient>> RemoteClient::Connect(const Remote
   args.SetMaxSendMessageSize(1 << 30);
   // Spread calls over every resolved address (headless services, lists).
   args.SetLoadBalancingPolicyName("round_robin");
+  // A server that comes back (a restart, a late start) is found within 5 s
+  // instead of gRPC's default of up to 120 s between connection attempts.
+  args.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, 5000);
   if (!o.tls_server_name.empty()) args.SetSslTargetNameOverride(o.tls_server_name);
   auto channel = grpc::CreateCustomChannel(o.target, creds, args);
   return std::unique_ptr<RemoteClient>(new RemoteClient(o, std::move(channel)));
@@ -217,6 +221,33 @@ absl::StatusOr<std::string> RemoteClient::Health(const std::string& service) {
   grpc::health::v1::HealthCheckResponse resp;
   RETURN_IF_ERROR(FromGrpc(health->Check(&ctx, req, &resp)));
   return grpc::health::v1::HealthCheckResponse::ServingStatus_Name(resp.status());
+}
+
+absl::Status RemoteClient::WaitUntilReachable(
+    double wait_s, const std::function<void(const std::string&)>& waiting) {
+  auto health = grpc::health::v1::Health::NewStub(channel_);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(wait_s);
+  for (bool told = false;; told = true) {
+    grpc::ClientContext ctx;
+    ctx.set_wait_for_ready(false);  // a refused connection fails the call at once
+    ctx.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(3));
+    if (!options_.auth_token.empty())
+      ctx.AddMetadata("authorization", "Bearer " + options_.auth_token);
+    grpc::health::v1::HealthCheckResponse resp;
+    const grpc::Status st = health->Check(&ctx, grpc::health::v1::HealthCheckRequest(), &resp);
+    // Any answer, even a refusal of the token or NOT_SERVING, is a server there.
+    if (st.error_code() != grpc::StatusCode::UNAVAILABLE &&
+        st.error_code() != grpc::StatusCode::DEADLINE_EXCEEDED)
+      return absl::OkStatus();
+    const std::string reason = st.error_code() == grpc::StatusCode::DEADLINE_EXCEEDED
+                                   ? "no answer within 3 s"
+                                   : st.error_message();
+    if (std::chrono::steady_clock::now() + std::chrono::milliseconds(250) >= deadline)
+      return absl::UnavailableError(
+          absl::StrCat("cannot reach surfinspectd at ", options_.target, ": ", reason));
+    if (!told && waiting) waiting(reason);
+    std::this_thread::sleep_for(std::chrono::milliseconds(250));
+  }
 }
 
 }  // namespace surfinspect::client

@@ -65,6 +65,19 @@ class RemoteClient {
   // "SERVING", "NOT_SERVING", ... or an error.
   absl::StatusOr<std::string> Health(const std::string& service = "");
 
+  // Whether the server answers at all, asked by a health check that does
+  // not wait for a connection (so a refused one fails at once, one without
+  // an answer after 3 s), repeated every 0.25 s for up to `wait_s` (0:
+  // once). A call waits for a connection until its deadline, so without
+  // this a wrong address or a server that is down would be told only after
+  // --timeout, as "Deadline Exceeded". Unavailable "cannot reach
+  // surfinspectd at TARGET: <gRPC's reason, e.g. Connection refused>".
+  // `waiting` is told the reason once when the first try fails and there
+  // is time left to wait.
+  absl::Status WaitUntilReachable(double wait_s,
+                                  const std::function<void(const std::string&)>& waiting = {});
+  const std::string& target() const { return options_.target; }
+
  private:
   explicit RemoteClient(const RemoteOptions& options, std::shared_ptr<grpc::Channel> channel);
   void Prepare(grpc::ClientContext* ctx) const;

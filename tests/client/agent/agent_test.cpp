@@ -9,6 +9,7 @@
 
 #include "core/io/io_point_cloud.h"
 #include "proto/convert.h"
+#include "tests/support/small_file_system.h"
 #include "tests/support/temp_dir.h"
 
 namespace surfinspect::client {
@@ -349,6 +350,55 @@ TEST_F(AgentTest, OnceRunProcessesTheInboxAndReturns) {
   EXPECT_EQ(calls_, 2);
   EXPECT_TRUE(CompleteParts(layout_.inbox).empty());
   EXPECT_TRUE(sleeps_.empty());
+}
+
+TEST_F(AgentTest, AFullDiskPausesWithThePartsInTheInboxAndResumesWhenSpaceReturns) {
+  std::string why;
+  const auto small = surfinspect::testing::SmallFileSystem::Mount(16 << 20, &why);
+  if (!small) GTEST_SKIP() << why;
+  layout_.results = small->File("results");
+  ASSERT_TRUE(PrepareDirectories(layout_).ok());
+  surfinspect::testing::FillWithZeros(small->File("filler"), uint64_t{32} << 20);
+  DiskGuard disk({layout_.results}, DiskConfig{0});
+  std::vector<std::string> told;
+  hooks_.disk = &disk;
+  hooks_.on_disk.push_back([&told](const std::string& reason) { told.push_back(reason); });
+  settings_.once = true;
+  DropPart("p1");
+  DropPart("p2");
+  CellAgent agent = Agent();
+  agent.Run(stop_, {});
+  EXPECT_EQ(calls_, 1) << "the first part found the disk full; the second was not sent";
+  ASSERT_EQ(told.size(), 1u);
+  EXPECT_NE(told[0].find("no space left"), std::string::npos) << told[0];
+  EXPECT_TRUE(InInbox("p1") && InInbox("p2"));
+  EXPECT_FALSE(fs::exists(fs::path(layout_.results) / "p1")) << "no half-written set";
+  agent.Run(stop_, {});  // still full: paused, nothing sent, nothing told again
+  EXPECT_EQ(calls_, 1);
+  EXPECT_EQ(told.size(), 1u);
+  fs::remove(small->File("filler"));
+  const RunSummary s = agent.Run(stop_, {});
+  EXPECT_EQ(s.done, 2);
+  ASSERT_EQ(told.size(), 2u);
+  EXPECT_EQ(told[1], "") << "resumed";
+  EXPECT_TRUE(HasResults(layout_, "p1") && HasResults(layout_, "p2"));
+  EXPECT_GT(disk.need_bytes(), 0u) << "a part's set size is known now";
+}
+
+TEST_F(AgentTest, UnfinishedSetsAreRemovedAndFinishedOnesKept) {
+  fs::create_directories(fs::path(layout_.results) / ".partial" / "p1.123.0");
+  WriteBytes((fs::path(layout_.results) / ".partial" / "p1.123.0" / "report.json").string(), "{}");
+  fs::create_directories(fs::path(layout_.results) / "p2");  // written in place, then killed
+  WriteBytes((fs::path(layout_.results) / "p2" / "errormap.ply").string(), "half");
+  fs::create_directories(fs::path(layout_.results) / "p3");
+  WriteBytes((fs::path(layout_.results) / "p3" / "report.json").string(), "{}");
+  WriteBytes((fs::path(layout_.results) / "results.db").string(), "");
+  auto removed = RemoveUnfinishedSets(layout_.results);
+  ASSERT_TRUE(removed.ok()) << removed.status();
+  EXPECT_EQ(*removed, (std::vector<std::string>{"p1.123.0", "p2"}));
+  EXPECT_TRUE(HasResults(layout_, "p3"));
+  EXPECT_TRUE(fs::exists(fs::path(layout_.results) / "results.db"));
+  EXPECT_FALSE(fs::exists(fs::path(layout_.results) / "p2"));
 }
 
 TEST(AgentLayoutTest, ArchiveAndQuarantineDefaultBesideTheInbox) {

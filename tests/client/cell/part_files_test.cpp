@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <set>
 
+#include "core/io/disk_space.h"
+#include "tests/support/small_file_system.h"
 #include "tests/support/temp_dir.h"
 
 namespace surfinspect::client {
@@ -77,12 +79,52 @@ TEST(PartFiles, WritesTheSetAndNothingElseWithTheReportLast) {
     written.insert(e.path().filename().string());
   EXPECT_EQ(written, (std::set<std::string>{"deviations.csv", "errormap.png", "report.json"}));
   EXPECT_EQ(testing::ReadBytes(dir.File("part/errormap.png")), "png bytes");
-  // A writer without its inputs fails, and then report.json is not written.
-  set.Set(PartFile::kPdf, true);
-  const absl::Status st = WritePartFiles(dir.File("other"), set, SomeInputs(points, map));
+}
+
+TEST(PartFiles, AFailedWriterLeavesNoFileOfTheSet) {
+  testing::TempDir dir;
+  const PointCloud points = PointCloud::Unorganized({{0, 0, 0}, {1, 0, 0}});
+  ErrorMapResult map;
+  map.deviation_mm = {0.01f, -0.02f};
+  map.tolerance_mm = 0.1;
+  map.color_range_mm = 0.2;
+  PartFileSet set;
+  set.Set(PartFile::kCsv, true);
+  set.Set(PartFile::kPng, true);
+  set.Set(PartFile::kPdf, true);  // written after the CSV and the PNG; fails without a report
+  uint64_t bytes = 0;
+  const absl::Status st = WritePartFiles(dir.File("part"), set, SomeInputs(points, map), &bytes);
   EXPECT_EQ(st.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_NE(st.message().find("report.pdf"), std::string::npos) << st;
-  EXPECT_FALSE(fs::exists(dir.File("other/report.json")));
+  EXPECT_FALSE(fs::exists(dir.File("part"))) << "neither the CSV nor the PNG written before it";
+  EXPECT_TRUE(fs::is_empty(dir.File(".partial")));
+  EXPECT_GT(bytes, 9u) << "what was written before the failure";
+}
+
+TEST(PartFiles, AFullDiskIsToldAndLeavesNoFile) {
+  std::string why;
+  const auto small = testing::SmallFileSystem::Mount(256 << 10, &why);
+  if (!small) GTEST_SKIP() << why;
+  std::vector<Eigen::Vector3f> xyz(50000, Eigen::Vector3f(1, 2, 3));
+  const PointCloud points = PointCloud::Unorganized(xyz);
+  ErrorMapResult map;
+  map.deviation_mm.assign(xyz.size(), 0.01f);
+  map.tolerance_mm = 0.1;
+  map.color_range_mm = 0.2;
+  PartFileSet set;
+  set.Set(PartFile::kPly, true);  // ~1 MB: more than the file system holds
+  const absl::Status st = WritePartFiles(small->File("results/part"), set, SomeInputs(points, map));
+  EXPECT_TRUE(IsDiskFull(st)) << st;
+  EXPECT_FALSE(fs::exists(small->File("results/part")));
+  EXPECT_TRUE(fs::is_empty(small->File("results/.partial")));
+  EXPECT_GT(DiskSpaceOf(small->path())->free_bytes, uint64_t{200} << 10) << "space given back";
+}
+
+TEST(PartFiles, HeavyFilesAreThoseThatGrowWithThePoints) {
+  std::set<std::string> heavy;
+  for (const PartFileEntry& e : PartFileCatalogue())
+    if (e.heavy) heavy.insert(e.name);
+  EXPECT_EQ(heavy, (std::set<std::string>{"ply", "csv", "html"}));
 }
 
 }  // namespace
