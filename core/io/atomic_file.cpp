@@ -12,6 +12,7 @@
 
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
+#include "core/io/disk_space.h"
 
 namespace surfinspect {
 namespace {
@@ -53,6 +54,9 @@ absl::Status WriteFileAtomically(
   if (st.ok() && std::rename(tmp.c_str(), path.c_str()) != 0)
     st = absl::InternalError(
         absl::StrCat("cannot rename ", tmp, " to ", path, ": ", std::strerror(errno)));
+  // Told while the temporary file still holds the space it took: after
+  // its removal a full disk no longer looks full.
+  if (!st.ok()) st = AsDiskFull(st, tmp);
   if (!st.ok()) std::remove(tmp.c_str());
   return st;
 }

@@ -12,7 +12,8 @@
 namespace surfinspect {
 
 // `write_to` receives the temporary path and must create the file there. On
-// any failure the temporary file is removed and the target is untouched.
+// any failure the temporary file is removed and the target is untouched; a
+// failure on a full file system is ResourceExhausted (core/io/disk_space.h).
 absl::Status WriteFileAtomically(
     const std::string& path,
     const std::function<absl::Status(const std::string& tmp_path)>& write_to);

@@ -8,6 +8,7 @@ scans folder given with a trailing slash; an inspect whose writing fails
 
 usage: unreachable_server_test.py BIN_DIR [unittest args]
 """
+import json
 import os
 import shutil
 import socket
@@ -40,6 +41,14 @@ class CliTests(unittest.TestCase):
         subprocess.run([os.path.join(BIN, "surfinspect"), "demo-cell", "--out", cls.cell, "--parts", "1"],
                        check=True, stdout=subprocess.DEVNULL)
         cls.scans = os.path.join(cls.cell, "scans", sorted(os.listdir(os.path.join(cls.cell, "scans")))[0])
+        # Calibration is not under test: the simulation's true poses stand in for it.
+        path = os.path.join(cls.cell, "cell.json")
+        with open(path) as f:
+            cell = json.load(f)
+        for vp in cell["viewpoints"]:
+            vp["world_from_sensor"] = vp["simulation_truth_world_from_sensor"]
+        with open(path, "w") as f:
+            json.dump(cell, f)
 
     @classmethod
     def tearDownClass(cls):

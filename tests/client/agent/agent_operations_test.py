@@ -122,6 +122,10 @@ class OperationsTests(unittest.TestCase):
         for p in part_folders(results):
             self.assertEqual(set(os.listdir(os.path.join(results, p))) - {".mqtt-delivered"}, files, p)
 
+    def read(self, name):
+        with open(os.path.join(self.dir, name)) as f:
+            return f.read()
+
     def wait_until(self, pred, timeout=120, what="condition"):
         deadline = time.time() + timeout
         while time.time() < deadline:
@@ -132,26 +136,30 @@ class OperationsTests(unittest.TestCase):
 
     def test_killed_at_random_moments_every_set_is_whole_and_each_part_done_once(self):
         self.drop(self.part_ids)
-        results = os.path.join(self.dir, "results")
+        for p in self.part_ids:  # each part twice, under a second id: 16 parts to kill through
+            shutil.copytree(os.path.join(self.parts, p), os.path.join(self.dir, "inbox", p + "-b"))
+        parts = sorted(self.part_ids + [p + "-b" for p in self.part_ids])
+        results, inbox = os.path.join(self.dir, "results"), os.path.join(self.dir, "inbox")
         rng = random.Random(44)
-        kills = 0
-        while kills < 12 and os.path.exists(os.path.join(self.dir, "inbox")) and \
-                [p for p in os.listdir(os.path.join(self.dir, "inbox")) if not p.startswith(".")]:
+        kills = mid_write = 0
+        while kills < 20 and [p for p in os.listdir(inbox) if not p.startswith(".")]:
             proc = self.agent(wait=False)
-            time.sleep(rng.uniform(0.3, 1.5))  # start-up is ~0.3 s; a part ~0.1-0.3 s
+            time.sleep(rng.uniform(0.25, 0.9))  # start-up takes ~0.3 s, a part ~0.3 s
             proc.send_signal(signal.SIGKILL)
             proc.communicate()
             kills += 1
             if os.path.exists(results):
+                staging = os.path.join(results, ".partial")
+                mid_write += bool(os.path.exists(staging) and os.listdir(staging))
                 self.assert_whole_sets(results)  # before any restart cleans up
         code, out, err = self.agent("--once")
         self.assertEqual(code, 0, err)
-        self.assertEqual(part_folders(results), self.part_ids)
+        self.assertEqual(part_folders(results), parts)
         self.assert_whole_sets(results)
-        self.assertEqual(sorted(os.listdir(os.path.join(self.dir, "archive"))), self.part_ids)
+        self.assertEqual(sorted(os.listdir(os.path.join(self.dir, "archive"))), parts)
         self.assertEqual(os.listdir(os.path.join(results, ".partial")), [])
-        self.assertEqual(db_part_ids(os.path.join(results, "results.db")), self.part_ids)
-        print(f"\n  {kills} kills", file=sys.stderr)
+        self.assertEqual(db_part_ids(os.path.join(results, "results.db")), parts)
+        print(f"\n  {kills} kills, {mid_write} of them while a set was being written", file=sys.stderr)
 
     def test_a_full_disk_pauses_publishes_and_resumes(self):
         mnt = os.path.join(self.dir, "results")
@@ -170,8 +178,7 @@ class OperationsTests(unittest.TestCase):
             f.write(b"\0" * (44 << 20))
         proc = self.agent("--mqtt", f"tcp://127.0.0.1:{broker.port}", "--status-dir", self.dir, wait=False)
         self.wait_until(lambda: retained_status(broker) == "disk_full", what="disk_full status")
-        metrics = open(os.path.join(self.dir, "agent_status.prom")).read()
-        self.assertIn('surfinspect_agent_disk_full{cell="cell"} 1', metrics)
+        self.assertIn('surfinspect_agent_disk_full{cell="cell"} 1', self.read("agent_status.prom"))
         self.assert_whole_sets(mnt)
         self.assertEqual(os.listdir(os.path.join(mnt, ".partial")), [])
         inbox = sorted(os.listdir(os.path.join(self.dir, "inbox")))
@@ -186,8 +193,7 @@ class OperationsTests(unittest.TestCase):
         self.assertEqual(err.count("disk space is back"), 1, err)
         self.assert_whole_sets(mnt)
         self.assertEqual(sorted(os.listdir(os.path.join(self.dir, "archive"))), self.part_ids[:4])
-        self.assertIn('surfinspect_agent_disk_full{cell="cell"} 0',
-                      open(os.path.join(self.dir, "agent_status.prom")).read())
+        self.assertIn('surfinspect_agent_disk_full{cell="cell"} 0', self.read("agent_status.prom"))
         states = [m["state"] for t, m in sub.messages() if t.endswith("/status")]
         self.assertIn("disk_full", states)
 

@@ -3,9 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <set>
 #include <string>
 
+#include "core/io/disk_space.h"
+#include "tests/support/small_file_system.h"
 #include "tests/support/temp_dir.h"
 
 namespace surfinspect {
@@ -69,6 +72,22 @@ TEST(AtomicFile, AFailedWriterLeavesTheTargetAndNoTemporaryFile) {
   EXPECT_FALSE(fs::exists(seen_tmp));
   EXPECT_EQ(ReadBytes(path), "the old, complete file");
   EXPECT_EQ(FilesIn(dir.path()), std::set<std::string>{"cloud.pcd"});
+}
+
+TEST(AtomicFile, AWriterOnAFullDiskIsToldAsAFullDiskWhateverItSaid) {
+  std::string why;
+  const auto small = testing::SmallFileSystem::Mount(1 << 20, &why);
+  if (!small) GTEST_SKIP() << why;
+  const absl::Status st =
+      WriteFileAtomically(small->File("map.ply"), [](const std::string& tmp) -> absl::Status {
+        std::ofstream out(tmp, std::ios::binary);
+        out << std::string(2 << 20, 'x');  // more than fits; the writer's own words say nothing
+        out.close();
+        return out ? absl::OkStatus() : absl::DataLossError("write failed: " + tmp);
+      });
+  EXPECT_TRUE(IsDiskFull(st)) << st;
+  EXPECT_NE(st.message().find("write failed"), std::string::npos) << "the writer's words kept";
+  EXPECT_TRUE(FilesIn(small->path()).empty()) << "no temporary file";
 }
 
 TEST(AtomicFile, AWriterThatCreatesNothingCannotBeRenamed) {
