@@ -212,9 +212,10 @@ PartReport CellAgent::InspectAndStore(const std::string& id, const std::vector<V
                                ? WritePartOutputs((fs::path(layout_.results) / id).string(),
                                                   *outputs, cell_.outputs, &bytes)
                                : outputs.status();
-    if (hooks_.disk != nullptr && (written.ok() || IsDiskFull(written))) {
-      written.ok() ? hooks_.disk->SetWritten(bytes) : hooks_.disk->SetFailed(bytes);
-      if (!written.ok()) SetDiskFull(std::string(written.message()));
+    if (hooks_.disk != nullptr && written.ok()) hooks_.disk->SetWritten(bytes);
+    if (hooks_.disk != nullptr && IsDiskFull(written)) {
+      hooks_.disk->SetFailed(bytes);
+      SetDiskFull(std::string(written.message()));
     }
     if (!written.ok()) {  // disk trouble: keep the part in the inbox for the next pass
       r = Report(PartOutcome::kRetryLater,

@@ -68,6 +68,14 @@ absl::Status MoveEach(const fs::path& staging, const fs::path& target, const std
   return SyncFolder(target);
 }
 
+// PARENT/.partial goes when it holds nothing, so that a results folder
+// lists exactly its sets between parts; while another set is staged there,
+// the removal fails and it stays.
+void RemoveRootIfEmpty(const fs::path& staging) {
+  std::error_code ec;
+  fs::remove(staging.parent_path(), ec);
+}
+
 }  // namespace
 
 std::string StagingRoot(const std::string& parent) {
@@ -80,15 +88,15 @@ absl::StatusOr<StagedFolder> StagedFolder::Begin(const std::string& target) {
   if (t.empty() || t.filename().empty() || t.filename() == "." || t.filename() == "..")
     return absl::InvalidArgumentError(absl::StrCat("\"", target, "\": not a folder name"));
   const fs::path root = StagingRoot(ParentOf(t).string());
-  std::error_code ec;
-  fs::create_directories(root, ec);
-  if (ec)
-    return absl::PermissionDeniedError(
-        absl::StrCat("cannot create ", root.string(), ": ", ec.message()));
   const fs::path staging =
       root / absl::StrCat(t.filename().string(), ".", ::getpid(), ".", counter++);
+  std::error_code ec;
   fs::remove_all(staging, ec);  // a leftover of a process that had our pid
-  if (!fs::create_directory(staging, ec) || ec)
+  // Twice: another writer may remove the empty root between its creation
+  // and the staging folder's.
+  for (int attempt = 0; attempt < 2 && !fs::is_directory(staging, ec); ++attempt)
+    fs::create_directories(staging, ec);
+  if (!fs::is_directory(staging, ec))
     return absl::PermissionDeniedError(
         absl::StrCat("cannot create ", staging.string(), ": ", ec.message()));
   return StagedFolder(t.string(), staging.string());
@@ -103,9 +111,10 @@ StagedFolder::StagedFolder(StagedFolder&& other) noexcept
       committed_(other.committed_) {}
 
 StagedFolder::~StagedFolder() {
-  if (committed_ || staging_.empty()) return;
+  if (staging_.empty()) return;
   std::error_code ec;
-  fs::remove_all(staging_, ec);
+  if (!committed_) fs::remove_all(staging_, ec);
+  RemoveRootIfEmpty(staging_);
 }
 
 uint64_t StagedFolder::Bytes() const {

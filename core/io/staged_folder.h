@@ -4,6 +4,7 @@
 // one rename(2). A crash, a kill or a full disk before Commit leaves the
 // target as it was (absent, or the previous set) and a leftover under
 // PARENT/.partial/, which RemoveStagingLeftovers clears at the next start.
+// PARENT/.partial itself is removed whenever it is left empty.
 //
 // The staging folder sits inside PARENT (not beside it) so that the rename
 // never crosses a mount point, and under a hidden name so that readers that
@@ -25,7 +26,7 @@ class StagedFolder {
   static absl::StatusOr<StagedFolder> Begin(const std::string& target);
   StagedFolder(StagedFolder&& other) noexcept;
   StagedFolder& operator=(StagedFolder&&) = delete;
-  ~StagedFolder();  // removes the staging folder unless committed
+  ~StagedFolder();  // removes the staging folder unless committed, and an empty .partial
 
   // Where to write the files.
   const std::string& path() const { return staging_; }

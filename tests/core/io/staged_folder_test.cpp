@@ -25,16 +25,18 @@ std::set<std::string> Names(const std::string& dir) {
 TEST(StagedFolder, NothingAppearsUntilCommitThenTheWholeSet) {
   TempDir dir;
   const std::string target = dir.File("part-1");
-  auto staged = StagedFolder::Begin(target);
-  ASSERT_TRUE(staged.ok()) << staged.status();
-  EXPECT_EQ(fs::path(staged->path()).parent_path(), fs::path(dir.File(".partial")));
-  WriteBytes(staged->path() + "/errormap.ply", "ply");
-  WriteBytes(staged->path() + "/report.json", "{}");
-  EXPECT_FALSE(fs::exists(target)) << "a reader sees no set in the making";
-  EXPECT_EQ(staged->Bytes(), 5u);
-  ASSERT_TRUE(staged->Commit("report.json").ok());
-  EXPECT_EQ(Names(target), (std::set<std::string>{"errormap.ply", "report.json"}));
-  EXPECT_TRUE(fs::is_empty(dir.File(".partial")));
+  {
+    auto staged = StagedFolder::Begin(target);
+    ASSERT_TRUE(staged.ok()) << staged.status();
+    EXPECT_EQ(fs::path(staged->path()).parent_path(), fs::path(dir.File(".partial")));
+    WriteBytes(staged->path() + "/errormap.ply", "ply");
+    WriteBytes(staged->path() + "/report.json", "{}");
+    EXPECT_FALSE(fs::exists(target)) << "a reader sees no set in the making";
+    EXPECT_EQ(staged->Bytes(), 5u);
+    ASSERT_TRUE(staged->Commit("report.json").ok());
+    EXPECT_EQ(Names(target), (std::set<std::string>{"errormap.ply", "report.json"}));
+  }
+  EXPECT_EQ(Names(dir.path()), std::set<std::string>{"part-1"}) << "the empty .partial goes too";
 }
 
 TEST(StagedFolder, AnAbandonedSetLeavesNothing) {
@@ -45,7 +47,7 @@ TEST(StagedFolder, AnAbandonedSetLeavesNothing) {
     WriteBytes(staged->path() + "/errormap.ply", "half");
   }  // e.g. the PDF writer failed: no Commit
   EXPECT_FALSE(fs::exists(dir.File("part-1")));
-  EXPECT_TRUE(fs::is_empty(dir.File(".partial")));
+  EXPECT_TRUE(fs::is_empty(dir.path()));
 }
 
 TEST(StagedFolder, ATrailingSlashNamesTheSameFolder) {
