@@ -58,11 +58,17 @@ absl::StatusOr<std::unique_ptr<RemoteClient>> RemoteClient::Connect(const Remote
   args.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, 5000);
   if (!o.tls_server_name.empty()) args.SetSslTargetNameOverride(o.tls_server_name);
   auto channel = grpc::CreateCustomChannel(o.target, creds, args);
-  return std::unique_ptr<RemoteClient>(new RemoteClient(o, std::move(channel)));
+  auto probe_channel = grpc::CreateCustomChannel(o.target, creds, args);
+  return std::unique_ptr<RemoteClient>(
+      new RemoteClient(o, std::move(channel), std::move(probe_channel)));
 }
 
-RemoteClient::RemoteClient(const RemoteOptions& o, std::shared_ptr<grpc::Channel> channel)
-    : options_(o), channel_(std::move(channel)), stub_(v1::InspectionService::NewStub(channel_)) {}
+RemoteClient::RemoteClient(const RemoteOptions& o, std::shared_ptr<grpc::Channel> channel,
+                           std::shared_ptr<grpc::Channel> probe_channel)
+    : options_(o),
+      channel_(std::move(channel)),
+      probe_channel_(std::move(probe_channel)),
+      stub_(v1::InspectionService::NewStub(channel_)) {}
 
 void RemoteClient::Prepare(grpc::ClientContext* ctx) const {
   ctx->set_deadline(std::chrono::system_clock::now() +
@@ -225,7 +231,7 @@ absl::StatusOr<std::string> RemoteClient::Health(const std::string& service) {
 
 absl::Status RemoteClient::WaitUntilReachable(
     double wait_s, const std::function<void(const std::string&)>& waiting) {
-  auto health = grpc::health::v1::Health::NewStub(channel_);
+  auto health = grpc::health::v1::Health::NewStub(probe_channel_);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(wait_s);
   for (bool told = false;; told = true) {
     grpc::ClientContext ctx;

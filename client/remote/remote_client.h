@@ -79,7 +79,8 @@ class RemoteClient {
   const std::string& target() const { return options_.target; }
 
  private:
-  explicit RemoteClient(const RemoteOptions& options, std::shared_ptr<grpc::Channel> channel);
+  RemoteClient(const RemoteOptions& options, std::shared_ptr<grpc::Channel> channel,
+               std::shared_ptr<grpc::Channel> probe_channel);
   void Prepare(grpc::ClientContext* ctx) const;
   // One unary call of the stub's `rpc` with this client's deadline and token.
   template <typename Request, typename Response>
@@ -92,6 +93,10 @@ class RemoteClient {
 
   RemoteOptions options_;
   std::shared_ptr<grpc::Channel> channel_;
+  // WaitUntilReachable's own channel: a probe on `channel_` would take a
+  // round_robin pick, and one probe before each part would then send every
+  // part to the same replica of two.
+  std::shared_ptr<grpc::Channel> probe_channel_;
   std::unique_ptr<v1::InspectionService::Stub> stub_;
 };
 
