@@ -206,7 +206,7 @@ absl::Status StartHousekeeping(const AgentArgs& a, const CellConfig& cell,
   ASSIGN_OR_RETURN(h.retention, RetentionConfigOf(cell));
   std::vector<std::string> folders = {layout.results, layout.archive};
   const std::string db = a.db.empty() ? layout.results + "/results.db" : a.db;
-  if (a.db != "none" && RedactDatabaseUrl(db) == db && db.find("://") == std::string::npos)
+  if (a.db != "none" && db.find("://") == std::string::npos)  // a file, not a server's URL
     folders.push_back(std::filesystem::path(db).parent_path().string());
   h.disk = std::make_unique<DiskGuard>(std::move(folders), disk);
   h.status_dir = StatusDir(a);
