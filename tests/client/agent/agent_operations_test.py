@@ -30,20 +30,12 @@ import time
 import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from agent_soak_test import shrink_sensor  # noqa: E402
+import agent_soak_test as soak  # noqa: E402
 from mqtt_e2e_test import Broker, Subscriber, free_port, retained_status  # noqa: E402
 
 BIN = None
 DEFAULT_FILES = {"report.json", "errormap.ply", "errormap.png", "report.pdf", "report.html", "result.qif"}
 HEAVY = {"errormap.ply", "report.html"}
-
-
-def start_server(port):
-    proc = subprocess.Popen([os.path.join(BIN, "surfinspectd"), "--listen", f"127.0.0.1:{port}",
-                             "--threads", "1"], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
-    assert "listening on" in proc.stdout.readline()
-    proc.stdout.close()
-    return proc
 
 
 def part_folders(results):
@@ -60,24 +52,15 @@ class OperationsTests(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.root = tempfile.mkdtemp(prefix="agent-ops-")
-        cell = os.path.join(cls.root, "template")
-        subprocess.run([os.path.join(BIN, "surfinspect"), "demo-cell", "--out", cell, "--parts", "0"],
-                       check=True, stdout=subprocess.DEVNULL)
-        path = os.path.join(cell, "cell.json")
-        shrink_sensor(path, 160, 120)  # small parts: ~0.3 s each
+        # The soak's small calibrated cell (160 x 120 pixels, ~0.3 s a part)
+        # and 8 parts made once, copied into each test's inbox.
+        cell_json = soak.make_cell(cls.root)
+        cls.template = os.path.dirname(cell_json)
+        staged = soak.stage_parts(cls.root, cell_json, 8, seed=5)
+        cls.parts = os.path.dirname(staged[0])
+        cls.part_ids = [os.path.basename(p) for p in staged]
         cls.port = free_port()
-        cls.server = start_server(cls.port)
-        subprocess.run([os.path.join(BIN, "cell-agent"), "calibrate", "--cell", path,
-                        "--server", f"127.0.0.1:{cls.port}"], check=True, capture_output=True)
-        # Parts made once, copied into each test's inbox.
-        cls.parts = os.path.join(cls.root, "parts")
-        subprocess.run([os.path.join(BIN, "cell-agent"), "run", "--cell", path, "--server", "127.0.0.1:1",
-                        "--inbox", cls.parts, "--results", os.path.join(cls.root, "throwaway"),
-                        "--simulate", "8", "--seed", "5", "--once", "--max-attempts", "1", "--timeout", "1"],
-                       capture_output=True)
-        cls.part_ids = sorted(os.listdir(cls.parts))
-        assert len(cls.part_ids) == 8, cls.part_ids
-        cls.template = cell
+        cls.server = soak.start_server(cls.port, os.path.join(cls.root, "server.log"))
 
     @classmethod
     def tearDownClass(cls):
@@ -224,7 +207,7 @@ class OperationsTests(unittest.TestCase):
         self.drop(self.part_ids[:1])
         proc = self.agent("--once", port=port, wait=False)
         time.sleep(3)
-        server = start_server(port)
+        server = soak.start_server(port, os.path.join(self.dir, "server.log"))
         self.stoppers.append(lambda: (server.kill(), server.wait()))
         out, err = proc.communicate(timeout=120)
         self.assertEqual(proc.returncode, 0, err)
@@ -234,5 +217,5 @@ class OperationsTests(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    BIN = sys.argv.pop(1)
+    BIN = soak.BIN = sys.argv.pop(1)
     unittest.main(verbosity=2)
