@@ -206,6 +206,7 @@ PartReport CellAgent::InspectAndStore(const std::string& id, const std::vector<V
       outputs->world_from_part = cell_.world_from_part;
       outputs->mesh_in_part = PartMesh();
       outputs->viewpoints = ViewpointCalibrations(cell_);
+      if (cell_.part_cad) outputs->cad = ReportCadOf(*cell_.part_cad);
     }
     uint64_t bytes = 0;
     absl::Status written = outputs.ok()

@@ -9,10 +9,12 @@
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "client/agent/housekeeping.h"
 #include "client/agent/retention.h"
 #include "client/agent/simulated_robot.h"
 #include "client/agent/store_recorder.h"
 #include "client/cell/cell_config.h"
+#include "client/cell/cell_part.h"
 #include "client/remote/remote_client.h"
 #include "core/io/atomic_file.h"
 #include "core/io/io_mesh.h"
@@ -180,69 +182,6 @@ absl::Status StartDriftChecks(const AgentArgs& a, const CellConfig& cell, const 
 }
 
 // The disk guard and the retention rule of a running agent.
-struct Housekeeping {
-  std::unique_ptr<DiskGuard> disk;
-  RetentionConfig retention;
-  std::string status_dir, cell;
-  int unsettled = 0;  // parts due for pruning that wait for the store or the broker
-};
-
-void WriteDiskMetrics(const Housekeeping& h, bool full, const AgentOutput& out) {
-  const std::string path = h.status_dir + "/agent_status.prom";
-  if (absl::Status st = WriteStringAtomically(path, DiskMetrics(h.cell, full, h.disk->Space()));
-      !st.ok())
-    Tell(out.warn, absl::StrCat("cannot write ", path, ": ", st.message()));
-}
-
-// Clears interrupted sets, and reads the disk and retention settings.
-absl::Status StartHousekeeping(const AgentArgs& a, const CellConfig& cell,
-                               const InboxLayout& layout, const AgentOutput& out, Housekeeping& h) {
-  ASSIGN_OR_RETURN(const std::vector<std::string> leftovers, RemoveUnfinishedSets(layout.results));
-  if (!leftovers.empty())
-    Tell(out.warn, absl::StrCat("removed ", leftovers.size(), " unfinished result sets (",
-                                absl::StrJoin(leftovers, ", "),
-                                "): their parts are in the inbox and are inspected again"));
-  ASSIGN_OR_RETURN(const DiskConfig disk, DiskConfigOf(cell));
-  ASSIGN_OR_RETURN(h.retention, RetentionConfigOf(cell));
-  std::vector<std::string> folders = {layout.results, layout.archive};
-  const std::string db = a.db.empty() ? layout.results + "/results.db" : a.db;
-  if (a.db != "none" && db.find("://") == std::string::npos)  // a file, not a server's URL
-    folders.push_back(std::filesystem::path(db).parent_path().string());
-  h.disk = std::make_unique<DiskGuard>(std::move(folders), disk);
-  h.status_dir = StatusDir(a);
-  h.cell = cell.name;
-  WriteDiskMetrics(h, false, out);
-  return absl::OkStatus();
-}
-
-// The disk guard's listeners: one log line per change, the metrics file.
-void WatchDisk(Housekeeping& h, const AgentOutput& out, AgentHooks& hooks) {
-  hooks.disk = h.disk.get();
-  hooks.on_disk.push_back([&h, &out](const std::string& reason) {
-    if (!reason.empty())
-      Tell(out.error, absl::StrCat(reason, "; parts wait in the inbox until space returns"));
-    else
-      Tell(out.info, "disk space is back; taking parts again");
-    WriteDiskMetrics(h, !reason.empty(), out);
-  });
-}
-
-// Applies the retention rule after a part, telling what it pruned, and how
-// many parts wait to be recorded or delivered when that number changes.
-void PruneAfterPart(Housekeeping& h, const InboxLayout& layout, const SettledFn& settled,
-                    const AgentOutput& out) {
-  if (!h.retention.any()) return;
-  const absl::StatusOr<PruneResult> r =
-      Prune(layout, h.retention, settled, std::chrono::system_clock::now());
-  if (!r.ok()) {
-    Tell(out.warn, absl::StrCat("retention: ", r.status().message()));
-    return;
-  }
-  if (r->heavy + r->light + r->archive > 0 || r->unsettled != h.unsettled)
-    Tell(out.info, absl::StrCat("retention: ", PruneText(*r)));
-  h.unsettled = r->unsettled;
-}
-
 }  // namespace
 
 std::string StatusDir(const AgentArgs& a) {
@@ -328,24 +267,39 @@ SettledFn SettledBy(const InboxLayout& layout, const StoreRecorder* recorder, bo
 
 absl::StatusOr<RunOutcome> RunCellCommand(const AgentArgs& a, const AgentOutput& out,
                                           std::atomic<bool>& stop) {
-  ASSIGN_OR_RETURN(const CellConfig cell, ReadCellConfig(a.cell));
+  ASSIGN_OR_RETURN(CellConfig cell, ReadCellConfig(a.cell));
+  // A part CAD that cannot be imported (a STEP file that crashes, hangs or
+  // exhausts the worker) stops no agent: each part is quarantined with why.
+  std::string cad_log;
+  const absl::Status part_ok = LoadCellPart(&cell, &cad_log);
+  Tell(part_ok.ok() ? out.info : out.error,
+       part_ok.ok() ? cad_log : std::string(part_ok.message()));
   RunOutcome outcome;
   const InboxLayout& layout = outcome.layout = ResolveLayout(a.paths);
   RETURN_IF_ERROR(PrepareDirectories(layout));
   Tell(out.info, absl::StrCat("inbox ", layout.inbox, ", results ", layout.results, ", archive ",
                               layout.archive, ", quarantine ", layout.quarantine));
   Housekeeping housekeeping;
-  RETURN_IF_ERROR(StartHousekeeping(a, cell, layout, out, housekeeping));
+  RETURN_IF_ERROR(StartHousekeeping(a, cell, layout, StatusDir(a), out, housekeeping));
   ASSIGN_OR_RETURN(const RobotDrift drift, RobotDriftOf(a));
   RETURN_IF_ERROR(SimulateIfAsked(a, cell, layout, drift, out));
-  ASSIGN_OR_RETURN(const TriangleMesh part, ReadMesh(cell.part_mesh));
-  ASSIGN_OR_RETURN(const std::optional<InspectionPlan> plan, PlanOf(cell, part, cell.error_map));
+  ASSIGN_OR_RETURN(const TriangleMesh part, part_ok.ok()
+                                                ? ReadMesh(cell.part_mesh)
+                                                : absl::StatusOr<TriangleMesh>(TriangleMesh{}));
+  ASSIGN_OR_RETURN(const std::optional<InspectionPlan> plan,
+                   part_ok.ok() ? PlanOf(cell, part, cell.error_map)
+                                : absl::StatusOr<std::optional<InspectionPlan>>(std::nullopt));
   ASSIGN_OR_RETURN(const std::unique_ptr<RemoteClient> client, ConnectFor(a, cell));
   ServerWatch watch;
   (void)watch.Ask(*client, out);  // says at start when the server is not there yet
   ASSIGN_OR_RETURN(const std::unique_ptr<MqttPublisher> mqtt, StartMqtt(a, cell, layout, out));
   AgentHooks hooks;
   hooks.inspect = InspectOver(*client, part, plan, out, watch);
+  if (!part_ok.ok())
+    hooks.inspect = [&part_ok](const v1::PartHeader&, const std::vector<ViewScan>&) {
+      return absl::StatusOr<v1::InspectResult>(absl::FailedPreconditionError(
+          absl::StrCat("the cell's part could not be imported: ", part_ok.message())));
+    };
   hooks.on_retry = [&out, &watch](const std::string& id, const absl::Status& st, int calls,
                                   double) {
     if (!watch.unreachable)  // said once by the watch
@@ -357,7 +311,8 @@ absl::StatusOr<RunOutcome> RunCellCommand(const AgentArgs& a, const AgentOutput&
   if (checks.monitor)
     hooks.before_part = [&checks](int done) { return checks.monitor->BeforePart(done); };
   ASSIGN_OR_RETURN(const std::unique_ptr<StoreRecorder> recorder,
-                   MakeRecorder(a, cell, layout, part, out));
+                   part_ok.ok() ? MakeRecorder(a, cell, layout, part, out)
+                                : absl::StatusOr<std::unique_ptr<StoreRecorder>>(nullptr));
   Listen(mqtt.get(), recorder.get(), hooks);
   const SettledFn settled = SettledBy(layout, recorder.get(), mqtt != nullptr);
   AgentSettings settings;
@@ -378,12 +333,13 @@ absl::StatusOr<RunOutcome> RunCellCommand(const AgentArgs& a, const AgentOutput&
 }
 
 absl::StatusOr<PruneResult> RunPruneCommand(const AgentArgs& a, const AgentOutput& out) {
-  ASSIGN_OR_RETURN(const CellConfig cell, ReadCellConfig(a.cell));
+  ASSIGN_OR_RETURN(CellConfig cell, ReadCellConfig(a.cell));
   ASSIGN_OR_RETURN(const RetentionConfig rule, RetentionConfigOf(cell));
   if (!rule.any())
     return absl::FailedPreconditionError(
         absl::StrCat(cell.path, ": no \"retention\" rule, nothing to prune (docs/cell-agent.md)"));
   const InboxLayout layout = ResolveLayout(a.paths);
+  RETURN_IF_ERROR(LoadCellPart(&cell, nullptr));
   ASSIGN_OR_RETURN(const TriangleMesh part, ReadMesh(cell.part_mesh));
   ASSIGN_OR_RETURN(const std::unique_ptr<StoreRecorder> recorder,
                    MakeRecorder(a, cell, layout, part, out));

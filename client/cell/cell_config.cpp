@@ -112,6 +112,32 @@ absl::Status ReadSettings(const nlohmann::json& j, CellConfig& c) {
   return st;
 }
 
+// "cad": how a STEP/IGES part is tessellated; validated by ValidateCadSettings.
+absl::Status ReadCad(const std::string& path, const nlohmann::json& j, CellConfig& c) {
+  c.cad_cache = (std::filesystem::path(path).parent_path() / ".cad-cache").string();
+  if (!j.contains("cad")) return absl::OkStatus();
+  const nlohmann::json& m = j["cad"];
+  if (!m.is_object()) return absl::InvalidArgumentError("cad must be an object");
+  TessellationSettings& t = c.cad.tessellation;
+  absl::Status st;
+  auto take = [&st](auto value, auto& into) {
+    if (value.ok())
+      into = *value;
+    else if (st.ok())
+      st = value.status();
+  };
+  take(Number(m, "chord_tolerance_mm", t.chord_tolerance_mm, "cad"), t.chord_tolerance_mm);
+  take(Number(m, "angular_tolerance_deg", t.angular_tolerance_deg, "cad"), t.angular_tolerance_deg);
+  take(Number(m, "timeout_s", c.cad.limits.seconds, "cad"), c.cad.limits.seconds);
+  take(Number(m, "memory_mb", c.cad.limits.memory_mb, "cad"), c.cad.limits.memory_mb);
+  RETURN_IF_ERROR(st);
+  t.body = m.value("body", "");
+  if (m.contains("cache")) c.cad_cache = Resolve(path, m["cache"].get<std::string>());
+  if (auto v = ValidateCadSettings(c.cad); !v.ok())
+    return absl::InvalidArgumentError(absl::StrCat("cad.", v.message()));
+  return absl::OkStatus();
+}
+
 // cell.json's "outputs": the catalogue names of the files each part gets
 // (client/cell/part_files.h).
 absl::StatusOr<PartFileSet> OutputsOf(const std::string& path, const nlohmann::json& list) {
@@ -162,7 +188,7 @@ absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
     if (!j.contains("part") || !j["part"].contains("mesh") ||
         !j["part"].contains("world_from_part"))
       return Bad(path, "needs part.mesh and part.world_from_part");
-    c.part_mesh = Resolve(path, j["part"]["mesh"].get<std::string>());
+    c.part_mesh = c.part_source = Resolve(path, j["part"]["mesh"].get<std::string>());
     auto wfp =
         TransformFromJsonValue(j["part"]["world_from_part"], path + ": part.world_from_part");
     if (!wfp.ok()) return wfp.status();
@@ -176,6 +202,7 @@ absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
       c.viewpoints.push_back(std::move(vp));
     }
     if (auto st = ReadSettings(j, c); !st.ok()) return Bad(path, st.message());
+    if (auto st = ReadCad(path, j, c); !st.ok()) return Bad(path, st.message());
     if (j.contains("plan")) {
       if (j["plan"].is_string()) {
         c.plan_source = Resolve(path, j["plan"].get<std::string>());

@@ -6,7 +6,12 @@
 //                                           Letters, digits, '.', '_', '-': it
 //                                           names the cell in results, events
 //                                           and the results store
-//   part.mesh, part.world_from_part         CAD of the part and its pose
+//   part.mesh, part.world_from_part         CAD of the part (a mesh, or a STEP/
+//                                           IGES file: client/cell/cell_part.h)
+//                                           and its pose
+//   cad{chord_tolerance_mm, angular_tolerance_deg, body, cache, timeout_s,
+//       memory_mb}                          optional: how a STEP/IGES part is
+//                                           tessellated (docs/cad.md)
 //   gauge.mesh                              CAD of the calibration gauge
 //   viewpoints[]: name, nominal_world_from_sensor, world_from_gauge,
 //                 gauge_scan, world_from_sensor (after calibration),
@@ -34,6 +39,8 @@
 
 #include "absl/status/statusor.h"
 #include "client/cell/part_files.h"
+#include "core/cad/cad_report.h"
+#include "core/cad/cad_settings.h"
 #include "core/errormap/error_map.h"
 #include "core/filter/link_clustering.h"
 #include "core/pipeline/inspection.h"
@@ -56,6 +63,13 @@ struct CellConfig {
   std::string path;                   // of cell.json
   std::string name;                   // the cell's name (see above)
   std::string part_mesh, gauge_mesh;  // resolved paths
+  // A STEP/IGES part: its tessellation settings and cache folder (default
+  // <cell folder>/.cad-cache). LoadCellPart points part_mesh at the cached
+  // mesh and keeps the file in part_source and the report in part_cad.
+  CadSettings cad;
+  std::string cad_cache;
+  std::string part_source;
+  std::optional<CadReport> part_cad;
   Eigen::Isometry3d world_from_part = Eigen::Isometry3d::Identity();
   std::vector<CellViewpoint> viewpoints;
   ErrorMapSettings error_map;

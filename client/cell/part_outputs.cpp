@@ -115,7 +115,8 @@ v1::PartHeader MakePartHeader(const std::string& part_id, const Eigen::Isometry3
 
 absl::Status WritePartOutputs(const std::string& dir, const PartOutputs& o,
                               const PartFileSet& files, uint64_t* bytes) {
-  ASSIGN_OR_RETURN(const InspectionReport report, ParseReport(o.report_json));
+  ASSIGN_OR_RETURN(InspectionReport report, ParseReport(o.report_json));
+  report.cad = o.cad;
   // The PLY/CSV writers only read deviations, tolerance and colour range.
   ErrorMapResult view;
   view.deviation_mm = o.deviation_mm;
@@ -131,7 +132,8 @@ absl::Status WritePartOutputs(const std::string& dir, const PartOutputs& o,
   in.points_in_part = &in_part;
   in.error_map = &view;
   in.report = &report;
-  in.report_text = o.report_json;
+  // Decoding then encoding gives the same text, so the text changes only by "cad".
+  in.report_text = o.cad ? ReportText(report) : o.report_json;
   in.png = o.png;
   in.mesh_in_part = o.mesh_in_part.get();
   in.viewpoints = o.viewpoints;

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,9 @@ struct PartOutputs {
   Eigen::Isometry3d world_from_part = Eigen::Isometry3d::Identity();
   std::shared_ptr<const TriangleMesh> mesh_in_part;
   std::vector<ViewpointCalibration> viewpoints;  // calibration status; empty: not known
+  // The part's tessellation when it came from STEP/IGES: written into
+  // report.json as "cad" (the server never sees the STEP file).
+  std::optional<ReportCad> cad;
 };
 
 // The lines of PartOutputs::failed and ::defects.

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "client/cell/cell_config.h"
+#include "client/cell/cell_part.h"
 #include "client/cell/part_outputs.h"
 #include "client/cell/part_recorder.h"
 #include "client/cell/report_context.h"
@@ -47,7 +48,10 @@ void Record(ResultsStore& store, const InspectArgs& a, const client::CellConfig&
 }
 
 void Inspect(const InspectArgs& a) {
-  const client::CellConfig cell = Take(client::ReadCellConfig(a.cell));
+  client::CellConfig cell = Take(client::ReadCellConfig(a.cell));
+  std::string cad_log;
+  Check(client::LoadCellPart(&cell, &cad_log));
+  if (!cad_log.empty()) std::fprintf(stderr, "%s\n", cad_log.c_str());
   const client::PartFileSet files =
       a.outputs.empty() ? cell.outputs : Take(client::ParsePartFileSet(a.outputs, "--outputs"));
   const std::unique_ptr<ResultsStore> store = a.db.empty() ? nullptr : OpenStore(a.db, false);
@@ -96,6 +100,7 @@ void Inspect(const InspectArgs& a) {
   outputs.world_from_part = cell.world_from_part;
   outputs.mesh_in_part = part_ptr;
   outputs.viewpoints = client::ViewpointCalibrations(cell);
+  if (cell.part_cad) outputs.cad = ReportCadOf(*cell.part_cad);
   Check(client::WritePartOutputs(a.out, outputs, files));
   std::printf("%s: %s  (min %.3f mm, max %.3f mm)  -> %s\n", part_id.c_str(),
               outputs.verdict.c_str(), outputs.min_mm, outputs.max_mm, a.out.c_str());

@@ -6,12 +6,15 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 
 #include "core/types/triangle_mesh.h"
 
 namespace surfinspect {
 
 std::string MeshSha256(const TriangleMesh& mesh);
+// Lowercase hex SHA-256 of any bytes (a CAD file's, for its cache key).
+std::string Sha256Hex(std::string_view bytes);
 // The same from the wire layout (12-byte vertices, 12-byte triangles).
 std::string MeshSha256(const std::string& vertex_bytes, const std::string& triangle_bytes);
 

@@ -20,4 +20,9 @@ namespace surfinspect {
 absl::StatusOr<MeshGroups> ObjGroups(std::string_view bytes, const TriangleMesh& imported,
                                      std::string_view name = "<obj>");
 
+// The OBJ text of `mesh` with its groups: a `g` line before each run of
+// triangles in the same groups, vertices with 9 significant digits (every
+// float comes back exact). Names must not hold blanks (InvalidArgument).
+absl::StatusOr<std::string> ObjWithGroups(const TriangleMesh& mesh, const MeshGroups& groups);
+
 }  // namespace surfinspect

@@ -156,6 +156,16 @@ void VisitMesh(V& v, R& m) {
   v("degenerate_triangles", m.degenerate_triangles);
 }
 
+template <typename V, typename R>
+void VisitCad(V& v, R& c) {
+  v("source", c.source);
+  v("format", c.format);
+  v("declared_unit", c.declared_unit);
+  v("chord_tolerance_mm", c.chord_tolerance_mm);
+  v("tessellation_error_mm", c.tessellation_error_mm);
+  v("tolerance_held", c.tolerance_held);
+}
+
 // A Visit function as the argument Object and List take.
 #define SURFINSPECT_VISIT(F) [](auto& v, auto& part) { F(v, part); }
 
@@ -184,6 +194,7 @@ void VisitReport(V& v, R& r) {
   }
   v.Object("inputs", r.inputs, SURFINSPECT_VISIT(VisitInputs));
   v.Object("mesh", r.mesh, SURFINSPECT_VISIT(VisitMesh));
+  v.Object("cad", r.cad, SURFINSPECT_VISIT(VisitCad));
   if (V::kReads || !r.output_frame.empty()) v("output_frame", r.output_frame);
 }
 
@@ -239,6 +250,11 @@ ReportDefect ReportDefectOf(const Defect& d) {
 }
 
 }  // namespace
+
+ReportCad ReportCadOf(const CadReport& r) {
+  return {r.source,        r.format, r.declared_unit, r.chord_tolerance_mm, r.tessellation_error_mm,
+          r.tolerance_held};
+}
 
 json EncodeReport(const InspectionReport& report) {
   JsonWriter w;

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "core/cad/cad_report.h"
 #include "core/errormap/error_map.h"
 #include "core/plan/characteristics.h"
 #include "core/plan/defects.h"
@@ -94,6 +95,16 @@ struct ReportInputs {
   std::string cloud, mesh, world_from_part;
 };
 
+// The CAD the deviations were measured against, when surfinspect tessellated
+// it from a STEP or IGES file: the measured tessellation error bounds how
+// much of each deviation is the mesh's own (docs/cad.md).
+struct ReportCad {
+  std::string source, format, declared_unit;
+  double chord_tolerance_mm = 0, tessellation_error_mm = 0;
+  bool tolerance_held = false;
+};
+ReportCad ReportCadOf(const CadReport& report);
+
 struct InspectionReport {
   std::string schema;   // kReportSchema with a plan; "" for an error-map report alone
   std::string verdict;  // the part verdict; "" without a plan
@@ -109,7 +120,8 @@ struct InspectionReport {
   // Written by the CLI's errormap only.
   std::optional<ReportInputs> inputs;
   std::optional<ReportMesh> mesh;
-  std::string output_frame;  // "" when not said
+  std::optional<ReportCad> cad;  // set by the client that tessellated the part
+  std::string output_frame;      // "" when not said
   bool pass() const { return verdict == "pass"; }
 };
 

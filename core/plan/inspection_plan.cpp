@@ -86,7 +86,7 @@ bool InRegion(const RegionSelector& s, uint32_t t, const Eigen::Vector3d& centro
     case RegionSelector::Kind::kTriangles:
       return std::binary_search(s.triangles.begin(), s.triangles.end(), t);
     case RegionSelector::Kind::kGroup:
-      return !groups.triangle_group.empty() && groups.triangle_group[t] == group_index;
+      return groups.Contains(t, group_index);
   }
   return false;
 }
@@ -208,7 +208,8 @@ void SelectGroupsByTriangles(InspectionPlan* plan, const MeshGroups& groups) {
     r.select.kind = RegionSelector::Kind::kTriangles;
     r.select.triangles.clear();
     for (std::size_t t = 0; t < groups.triangle_group.size(); ++t)
-      if (groups.triangle_group[t] == g) r.select.triangles.push_back(static_cast<uint32_t>(t));
+      if (groups.Contains(static_cast<uint32_t>(t), g))
+        r.select.triangles.push_back(static_cast<uint32_t>(t));
   }
 }
 

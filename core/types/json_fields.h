@@ -137,6 +137,25 @@ class JsonReader {
     const bool ok = x->is_array() && std::all_of(x->begin(), x->end(), IsCount);
     Take(key, ok, "a list of counts", [&] { v = x->get<std::vector<std::size_t>>(); });
   }
+  void operator()(const char* key, std::vector<double>& v) {
+    const nlohmann::json* x = Get(key);
+    if (!x) return;
+    const bool ok = x->is_array() && std::all_of(x->begin(), x->end(), [](const nlohmann::json& c) {
+                      return c.is_number() || c.is_null();
+                    });
+    Take(key, ok, "a list of numbers", [&] {
+      v.clear();
+      for (const nlohmann::json& c : *x) v.push_back(c.is_null() ? NAN : c.get<double>());
+    });
+  }
+  void operator()(const char* key, std::vector<std::string>& v) {
+    const nlohmann::json* x = Get(key);
+    if (!x) return;
+    const bool ok = x->is_array() && std::all_of(x->begin(), x->end(), [](const nlohmann::json& c) {
+                      return c.is_string();
+                    });
+    Take(key, ok, "a list of strings", [&] { v = x->get<std::vector<std::string>>(); });
+  }
   void operator()(const char* key, Eigen::Vector3d& v) {
     const nlohmann::json* x = Get(key);
     if (!x) return;

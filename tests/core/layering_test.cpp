@@ -15,7 +15,7 @@ namespace fs = std::filesystem;
 namespace {
 
 // The stages, lowest first; core/CMakeLists.txt lists the same order.
-const std::vector<std::string> kStages = {"types",        "io",       "filter",     "distance",
+const std::vector<std::string> kStages = {"types",        "io",       "filter",     "distance",   "cad",
                                           "registration", "errormap", "plan",       "pipeline",
                                           "report",       "history",  "acceptance", "simulation"};
 
