@@ -5,6 +5,7 @@
 #include "client/cli/commands.h"
 #include "core/io/io_mesh.h"
 #include "core/io/io_point_cloud.h"
+#include "core/io/pcd_format.h"
 
 namespace surfinspect::cli {
 namespace {
@@ -18,27 +19,34 @@ void PrintBounds(const Bounds3& b) {
   std::printf("bounds max: %.4f %.4f %.4f mm\n", b.max.x(), b.max.y(), b.max.z());
 }
 
+void PrintCloud(const std::string& path, const PointCloud& cloud) {
+  std::printf("file: %s\ntype: point cloud\npoints: %zu\nvalid: %zu\n", path.c_str(), cloud.size(),
+              cloud.CountValid());
+  if (cloud.organized())
+    std::printf("organized: yes (%u x %u)\n", cloud.width, cloud.height);
+  else
+    std::printf("organized: no\n");
+  PrintBounds(ComputeBounds(cloud));
+}
+
 void Info(const std::string& path) {
   const auto dot = path.rfind('.');
   const std::string ext =
       dot == std::string::npos ? "" : absl::AsciiStrToLower(path.substr(dot + 1));
   if (ext == "pcd") {
-    const PointCloud cloud = Take(ReadPointCloud(path));
-    std::printf("file: %s\ntype: point cloud\npoints: %zu\nvalid: %zu\n", path.c_str(),
-                cloud.size(), cloud.CountValid());
-    if (cloud.organized())
-      std::printf("organized: yes (%u x %u)\n", cloud.width, cloud.height);
-    else
-      std::printf("organized: no\n");
-    PrintBounds(ComputeBounds(cloud));
+    PrintCloud(path, Take(ReadPointCloud(path)));
+    if (const PcdHeader header = Take(ReadPcdHeader(path)); header.viewpoint) {
+      const PcdViewpoint& v = *header.viewpoint;
+      std::printf(
+          "viewpoint: translation %.9g %.9g %.9g, rotation (w x y z) %.9g %.9g %.9g %.9g "
+          "(not applied to the points)\n",
+          v.tx, v.ty, v.tz, v.qw, v.qx, v.qy, v.qz);
+    }
     return;
   }
   // PLY may be a mesh or a cloud: a file with faces is a mesh.
   if (ext == "ply" && !PlyDeclaresFaces(path)) {
-    const PointCloud cloud = Take(ReadPointCloud(path));
-    std::printf("file: %s\ntype: point cloud\npoints: %zu\nvalid: %zu\norganized: no\n",
-                path.c_str(), cloud.size(), cloud.CountValid());
-    PrintBounds(ComputeBounds(cloud));
+    PrintCloud(path, Take(ReadPointCloud(path)));
     return;
   }
   const TriangleMesh mesh = Take(ReadMesh(path));

@@ -33,19 +33,22 @@ std::string Extension(const std::string& path) {
 
 // STL and OBJ, after mesh_precheck.h passed them: Assimp merges identical
 // vertices by position alone once normals, UVs and colours are dropped (STL
-// stores a face normal with every corner).
-absl::StatusOr<TriangleMesh> ImportWithAssimp(const std::string& path) {
+// stores a face normal with every corner). An STL is imported from its
+// checked bytes (`stl`), an OBJ from `path`.
+absl::StatusOr<TriangleMesh> ImportWithAssimp(const std::string& path, const std::string* stl) {
   Assimp::Importer importer;
   importer.SetPropertyInteger(
       AI_CONFIG_PP_RVC_FLAGS,
       aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS | aiComponent_COLORS |
           aiComponent_TEXCOORDS | aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS |
           aiComponent_TEXTURES | aiComponent_LIGHTS | aiComponent_CAMERAS | aiComponent_MATERIALS);
+  const unsigned flags = aiProcess_RemoveComponent | aiProcess_Triangulate |
+                         aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices |
+                         aiProcess_ValidateDataStructure;
   const aiScene* scene = nullptr;
   try {
-    scene = importer.ReadFile(
-        path, aiProcess_RemoveComponent | aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                  aiProcess_PreTransformVertices | aiProcess_ValidateDataStructure);
+    scene = stl ? importer.ReadFileFromMemory(stl->data(), stl->size(), flags, "stl")
+                : importer.ReadFile(path, flags);
   } catch (const std::exception& e) {
     return Bad(path, absl::StrCat("importer error: ", e.what()));
   }
@@ -73,10 +76,12 @@ absl::StatusOr<TriangleMesh> ReadByFormat(const std::string& path, const std::st
   ASSIGN_OR_RETURN(auto bytes, ReadWholeFile(path, limits.max_file_bytes));
   if (ext == "ply") return ParsePlyMesh(bytes, limits, path);
   if (ext == "off") return ParseOff(bytes, limits, path);
-  const absl::Status check =
-      ext == "stl" ? CheckStl(bytes, limits, path) : CheckObj(bytes, limits, path);
-  if (!check.ok()) return check;
-  return ImportWithAssimp(path);
+  if (ext == "stl") {
+    RETURN_IF_ERROR(CheckStlForAssimp(&bytes, limits, path));
+    return ImportWithAssimp(path, &bytes);
+  }
+  RETURN_IF_ERROR(CheckObj(bytes, limits, path));
+  return ImportWithAssimp(path, nullptr);
 }
 
 }  // namespace

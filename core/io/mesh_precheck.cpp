@@ -4,6 +4,7 @@
 #include <cstring>
 #include <iterator>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "core/io/obj_lines.h"
 #include "core/io/text_parse.h"
@@ -24,9 +25,11 @@ absl::Status TooMany(std::string_view name, uint64_t n, const MeshReadLimits& li
 }
 
 // Whitespace-separated words of an ASCII STL, with the line each is on.
+// Keywords match in any case; with `lower` (a writable copy of the same
+// bytes), each keyword matched is written back there in lower case.
 class Words {
  public:
-  explicit Words(std::string_view s) : s_(s) {}
+  Words(std::string_view s, char* lower) : s_(s), lower_(lower) {}
   bool Next(std::string_view* w) {
     while (pos_ < s_.size() && std::strchr(" \t\r\n\v\f", s_[pos_]) && s_[pos_] != '\0') {
       if (s_[pos_] == '\n') ++line_;
@@ -38,6 +41,12 @@ class Words {
     *w = s_.substr(start, pos_ - start);
     return true;
   }
+  // Whether `word`, returned by Next, is `keyword` (lower case) in any case.
+  bool Is(std::string_view word, std::string_view keyword) {
+    if (!absl::EqualsIgnoreCase(ToAbsl(word), ToAbsl(keyword))) return false;
+    if (lower_) std::memcpy(lower_ + (word.data() - s_.data()), keyword.data(), keyword.size());
+    return true;
+  }
   void SkipLine() {
     while (pos_ < s_.size() && s_[pos_] != '\n') ++pos_;
   }
@@ -45,12 +54,13 @@ class Words {
 
  private:
   std::string_view s_;
+  char* lower_;
   std::size_t pos_ = 0, line_ = 1;
 };
 
-bool Expect(Words* w, std::string_view word) {
+bool Expect(Words* w, std::string_view keyword) {
   std::string_view got;
-  return w->Next(&got) && got == word;
+  return w->Next(&got) && w->Is(got, keyword);
 }
 
 bool Numbers(Words* w, int n) {
@@ -61,20 +71,23 @@ bool Numbers(Words* w, int n) {
   return true;
 }
 
-// One facet after its "facet" word; returns its vertex count in *vertices.
-absl::Status Facet(Words* w, uint64_t index, std::string_view name) {
+// One facet after its "facet" word. Errors here and in CheckAsciiStl are
+// the reason alone; CheckStl names the file and the other interpretation.
+absl::Status Facet(Words* w, uint64_t index) {
   const auto bad = [&](absl::string_view why) {
-    return Refuse(name, absl::StrCat("ASCII STL facet ", index, " (line ", w->line(), "): ", why));
+    return absl::InvalidArgumentError(
+        absl::StrCat("facet ", index, " (line ", w->line(), "): ", why));
   };
   if (!Expect(w, "normal") || !Numbers(w, 3)) return bad("expected 'normal' and 3 numbers");
   if (!Expect(w, "outer") || !Expect(w, "loop")) return bad("expected 'outer loop'");
   uint64_t vertices = 0;
   std::string_view word;
-  while (w->Next(&word) && word == "vertex") {
+  bool more = false;
+  while ((more = w->Next(&word)) && w->Is(word, "vertex")) {
     if (!Numbers(w, 3)) return bad("a vertex needs 3 numbers");
     ++vertices;
   }
-  if (word != "endloop") return bad("expected 'vertex' or 'endloop'");
+  if (!more || !w->Is(word, "endloop")) return bad("expected 'vertex' or 'endloop'");
   if (vertices != 3)
     return bad(absl::StrCat("has ", vertices, " vertices (a facet needs exactly 3)"));
   if (!Expect(w, "endfacet")) return bad("expected 'endfacet'");
@@ -82,53 +95,68 @@ absl::Status Facet(Words* w, uint64_t index, std::string_view name) {
 }
 
 absl::Status CheckAsciiStl(std::string_view bytes, const MeshReadLimits& limits,
-                           std::string_view name) {
-  Words w(bytes);
+                           std::string_view name, char* lower) {
+  Words w(bytes, lower);
   std::string_view word;
   uint64_t facets = 0, solids = 0;
   while (w.Next(&word)) {
-    if (word != "solid")
-      return Refuse(name, absl::StrCat("ASCII STL line ", w.line(), ": expected 'solid'"));
+    if (!w.Is(word, "solid"))
+      return absl::InvalidArgumentError(absl::StrCat("line ", w.line(), ": expected 'solid'"));
     w.SkipLine();  // the solid's name
     ++solids;
     while (true) {
-      if (!w.Next(&word)) return Refuse(name, "ASCII STL ends without 'endsolid'");
-      if (word == "endsolid") {
+      if (!w.Next(&word)) return absl::InvalidArgumentError("ends without 'endsolid'");
+      if (w.Is(word, "endsolid")) {
         w.SkipLine();
         break;
       }
-      if (word != "facet")
-        return Refuse(
-            name, absl::StrCat("ASCII STL line ", w.line(),
-                               ": expected 'facet' or 'endsolid', found '", Excerpt(word), "'"));
-      RETURN_IF_ERROR(Facet(&w, facets, name));
+      if (!w.Is(word, "facet"))
+        return absl::InvalidArgumentError(absl::StrCat(
+            "line ", w.line(), ": expected 'facet' or 'endsolid', found '", Excerpt(word), "'"));
+      RETURN_IF_ERROR(Facet(&w, facets));
       if (++facets > limits.max_triangles) return TooMany(name, facets, limits);
     }
   }
-  if (solids == 0) return Refuse(name, "ASCII STL holds no solid");
+  if (solids == 0) return absl::InvalidArgumentError("holds no solid");
   return absl::OkStatus();
+}
+
+absl::Status CheckStlBytes(std::string_view bytes, const MeshReadLimits& limits,
+                           std::string_view name, char* lower) {
+  uint32_t n = 0;
+  if (bytes.size() >= 84) std::memcpy(&n, bytes.data() + 80, 4);
+  const uint64_t binary_size = 84 + 50 * uint64_t{n};
+  if (bytes.size() >= 84 && binary_size == bytes.size()) {
+    if (n > limits.max_triangles) return TooMany(name, n, limits);
+    return absl::OkStatus();
+  }
+  const std::string as_binary =
+      bytes.size() < 84 ? absl::StrCat("size ", bytes.size(), " is under the 84-byte header")
+                        : absl::StrCat("size ", bytes.size(), " does not match 84 + 50 * ", n,
+                                       " = ", binary_size);
+  std::size_t start = 0;
+  while (start < bytes.size() && std::strchr(" \t\r\n", bytes[start]) && bytes[start] != '\0')
+    ++start;
+  if (!absl::EqualsIgnoreCase(ToAbsl(bytes.substr(start, 5)), "solid"))
+    return Refuse(name, absl::StrCat("neither ASCII STL (no 'solid' at the start) nor binary STL: ",
+                                     as_binary));
+  // A binary STL's 80-byte header may start with "solid" too: when the
+  // ASCII reading fails, both readings are named.
+  const absl::Status ascii = CheckAsciiStl(bytes, limits, name, lower);
+  if (ascii.code() != absl::StatusCode::kInvalidArgument) return ascii;
+  return Refuse(name,
+                absl::StrCat("as ASCII STL: ", ascii.message(), "; as binary STL: ", as_binary));
 }
 
 }  // namespace
 
 absl::Status CheckStl(std::string_view bytes, const MeshReadLimits& limits, std::string_view name) {
-  if (bytes.size() >= 84) {
-    uint32_t n = 0;
-    std::memcpy(&n, bytes.data() + 80, 4);
-    if (84 + 50 * uint64_t{n} == bytes.size()) {
-      if (n > limits.max_triangles) return TooMany(name, n, limits);
-      return absl::OkStatus();
-    }
-  }
-  std::size_t start = 0;
-  while (start < bytes.size() && std::strchr(" \t\r\n", bytes[start]) && bytes[start] != '\0')
-    ++start;
-  if (bytes.substr(start, 5) == "solid") return CheckAsciiStl(bytes.substr(start), limits, name);
-  if (bytes.size() < 84) return Refuse(name, "too short for a binary STL and not an ASCII one");
-  uint32_t n = 0;
-  std::memcpy(&n, bytes.data() + 80, 4);
-  return Refuse(name, absl::StrCat("binary STL declares ", n, " triangles (", 84 + 50 * uint64_t{n},
-                                   " bytes), the file has ", bytes.size()));
+  return CheckStlBytes(bytes, limits, name, nullptr);
+}
+
+absl::Status CheckStlForAssimp(std::string* bytes, const MeshReadLimits& limits,
+                               std::string_view name) {
+  return CheckStlBytes(*bytes, limits, name, bytes->data());
 }
 
 namespace {

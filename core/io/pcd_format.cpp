@@ -1,5 +1,6 @@
 #include "core/io/pcd_format.h"
 
+#include <fstream>
 #include <limits>
 #include <map>
 
@@ -51,17 +52,19 @@ absl::Status ReadEntries(std::string_view bytes, std::string_view name, Entries*
   return BadFile(name, "truncated header: no 'DATA' line");
 }
 
-absl::Status CheckSimpleEntries(const Entries& e, std::string_view name) {
+absl::Status CheckSimpleEntries(const Entries& e, std::string_view name, PcdHeader* h) {
   if (auto it = e.find("VERSION"); it != e.end()) {
     double v = 0;
     if (it->second.size() != 1 || !ParseDouble(it->second[0], &v))
       return BadFile(name, "PCD header: bad VERSION");
   }
   if (auto it = e.find("VIEWPOINT"); it != e.end()) {
-    double v = 0;
+    PcdViewpoint vp;
+    double* const values[] = {&vp.tx, &vp.ty, &vp.tz, &vp.qw, &vp.qx, &vp.qy, &vp.qz};
     bool ok = it->second.size() == 7;
-    for (std::size_t i = 0; ok && i < 7; ++i) ok = ParseDouble(it->second[i], &v);
+    for (std::size_t i = 0; ok && i < 7; ++i) ok = ParseDouble(it->second[i], values[i]);
     if (!ok) return BadFile(name, "PCD header: VIEWPOINT needs 7 numbers");
+    h->viewpoint = vp;
   }
   return absl::OkStatus();
 }
@@ -162,12 +165,23 @@ absl::StatusOr<PcdHeader> ParsePcdHeader(std::string_view bytes, const CloudRead
   RETURN_IF_ERROR(ReadEntries(bytes, name, &e, &h.data_offset));
   for (const char* key : {"FIELDS", "SIZE", "TYPE", "WIDTH", "HEIGHT", "POINTS", "DATA"})
     if (!e.count(key)) return BadFile(name, absl::StrCat("PCD header lacks ", key));
-  RETURN_IF_ERROR(CheckSimpleEntries(e, name));
+  RETURN_IF_ERROR(CheckSimpleEntries(e, name, &h));
   RETURN_IF_ERROR(BuildFields(e, name, &h));
   RETURN_IF_ERROR(CheckXyz(h, name));
   RETURN_IF_ERROR(ParseDims(e, limits, name, &h));
   RETURN_IF_ERROR(ParseData(e, name, &h));
   return h;
+}
+
+absl::StatusOr<PcdHeader> ReadPcdHeader(const std::string& path, const CloudReadLimits& limits) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return absl::NotFoundError(absl::StrCat(path, ": cannot open"));
+  // One byte past the longest header: a DATA line cut at the end of the
+  // read then ends past kMaxHeaderBytes and is refused, never misread.
+  std::string head(kMaxHeaderBytes + 1, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  return ParsePcdHeader(head, limits, path);
 }
 
 absl::StatusOr<PointCloud> ParsePcd(std::string_view bytes, const CloudReadLimits& limits,

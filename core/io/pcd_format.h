@@ -11,6 +11,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -31,6 +32,15 @@ struct PcdField {
   uint64_t offset = 0;  // byte offset inside a binary point record
 };
 
+// A PCD's VIEWPOINT: the sensor's pose as PCL keeps it (sensor_origin_,
+// sensor_orientation_), a translation in the points' units and a rotation
+// quaternion, in the file's order. Reported, never applied to the points
+// (PCL's reader does not apply it either).
+struct PcdViewpoint {
+  double tx = 0, ty = 0, tz = 0;
+  double qw = 1, qx = 0, qy = 0, qz = 0;
+};
+
 struct PcdHeader {
   std::vector<PcdField> fields;
   uint32_t width = 0, height = 0;
@@ -38,13 +48,20 @@ struct PcdHeader {
   uint64_t point_step = 0;        // bytes per point record
   uint64_t values_per_point = 0;  // numbers per ascii data line
   PcdData data = PcdData::kBinary;
-  std::size_t data_offset = 0;  // first byte after the DATA line
+  std::size_t data_offset = 0;            // first byte after the DATA line
+  std::optional<PcdViewpoint> viewpoint;  // when the header has a VIEWPOINT line
 };
 
 // Errors are INVALID_ARGUMENT ("NAME: why"), or RESOURCE_EXHAUSTED when the
 // declared count exceeds `limits`.
 absl::StatusOr<PcdHeader> ParsePcdHeader(std::string_view bytes, const CloudReadLimits& limits,
                                          std::string_view name);
+
+// The header of the PCD file at `path`, read from the file's first bytes
+// (a header must end within 64 KiB); the data section is not read.
+// NOT_FOUND when the file cannot be opened.
+absl::StatusOr<PcdHeader> ReadPcdHeader(const std::string& path,
+                                        const CloudReadLimits& limits = {});
 
 absl::StatusOr<PointCloud> ParsePcd(std::string_view bytes, const CloudReadLimits& limits = {},
                                     std::string_view name = "<pcd>");

@@ -142,6 +142,22 @@ absl::Status CheckGrid(const PlyHeader& h, uint64_t vertices, std::string_view n
   return absl::OkStatus();
 }
 
+// The cloud of `pts`, in grid order: num_cols x num_rows when the header
+// gives both (CheckGrid matched them to the points), unorganized otherwise.
+// Cell r is row r / num_cols, column r % num_cols, as in PCL's PLYReader,
+// which copies range_grid cell r to point r of its row-major cloud.
+absl::StatusOr<PointCloud> Arrange(const PlyHeader& h, std::vector<Eigen::Vector3f> pts,
+                                   std::string_view name) {
+  PointCloud cloud = PointCloud::Unorganized(std::move(pts));
+  if (h.num_cols && h.num_rows) {
+    // Each is at most the point count; a truncated one fails Validate.
+    cloud.width = static_cast<uint32_t>(*h.num_cols);
+    cloud.height = static_cast<uint32_t>(*h.num_rows);
+  }
+  if (auto st = cloud.Validate(); !st.ok()) return BadFile(name, st.message());
+  return cloud;
+}
+
 }  // namespace
 
 absl::StatusOr<PointCloud> ParsePlyCloud(std::string_view bytes, const CloudReadLimits& limits,
@@ -170,9 +186,7 @@ absl::StatusOr<PointCloud> ParsePlyCloud(std::string_view bytes, const CloudRead
       if (cells[r] >= 0) grid[r] = pts[cells[r]];
     pts.swap(grid);
   }
-  PointCloud cloud = PointCloud::Unorganized(std::move(pts));
-  if (auto st = cloud.Validate(); !st.ok()) return BadFile(name, st.message());
-  return cloud;
+  return Arrange(h, std::move(pts), name);
 }
 
 namespace {
@@ -240,10 +254,7 @@ std::optional<absl::StatusOr<PointCloud>> ReadPackedXyzPly(const std::string& pa
   if (h->data_offset > size || (size - h->data_offset) / 12 < count) return std::nullopt;
   std::vector<Eigen::Vector3f> pts(count);  // Eigen's points: allocated, not zeroed
   if (!ReadAt(file.fd, pts.data(), 12 * count, h->data_offset)) return std::nullopt;
-  PointCloud cloud = PointCloud::Unorganized(std::move(pts));
-  if (auto st = cloud.Validate(); !st.ok())
-    return absl::StatusOr<PointCloud>(BadFile(path, st.message()));
-  return absl::StatusOr<PointCloud>(std::move(cloud));
+  return Arrange(*h, std::move(pts), path);
 }
 
 }  // namespace surfinspect

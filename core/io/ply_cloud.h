@@ -1,9 +1,11 @@
 // A point cloud from PLY bytes (ply_format.h does the parsing): the vertex
 // element's x, y and z (float32 or float64; other properties and elements
-// are read past). PLY stores no grid, so the cloud comes out unorganized,
-// in vertex order, as PCL's reader gave it. obj_info num_cols / num_rows
-// must multiply to the vertex count; with a range_grid element of that many
-// cells (PCL's organized PLY), empty cells become NaN points.
+// are read past). obj_info num_cols / num_rows must multiply to the vertex
+// count or, with a range_grid element of another size (the Stanford range
+// scans', PCL's organized PLY), to its cell count: cell r holds its first
+// vertex, an empty cell a NaN point. With both, the cloud is organized,
+// width num_cols, height num_rows, cell r at row r / num_cols, column
+// r % num_cols (as PCL's reader gives it); without, it is unorganized.
 #pragma once
 
 #include <optional>

@@ -63,6 +63,52 @@ INSTANTIATE_TEST_SUITE_P(Formats, MeshRoundTrip,
                                            std::make_pair(MeshFormat::kPlyAscii,
                                                           "cube_ascii.ply")));
 
+// An ASCII STL of `m` with its keywords spelled by `kw` (solid, facet
+// normal, outer loop, vertex, endloop, endfacet, endsolid), the solid's name
+// and the numbers alike in every spelling.
+std::string AsciiStl(const TriangleMesh& m, const std::vector<std::string>& kw) {
+  std::string s = kw[0] + " Bracket_Rev facet\n";
+  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+    const Eigen::Vector3f n = m.FaceNormals()[t];
+    s += " " + kw[1] + " " + std::to_string(n.x()) + " " + std::to_string(n.y()) + " " +
+         std::to_string(n.z()) + "\n  " + kw[2] + "\n";
+    for (int c = 0; c < 3; ++c) {
+      const Eigen::Vector3f& v = m.vertices[m.triangles[t][c]];
+      s += "   " + kw[3] + " " + std::to_string(v.x()) + " " + std::to_string(v.y()) + " " +
+           std::to_string(v.z()) + "\n";
+    }
+    s += "  " + kw[4] + "\n " + kw[5] + "\n";
+  }
+  return s + kw[6] + " Bracket_Rev facet\n";
+}
+
+// Assimp 5.2 reads "FACET NORMAL" as no facet and "SOLID" as no STL; the
+// reader hands it the keywords in lower case, so every spelling gives the
+// same mesh.
+TEST(ReadMesh, AsciiStlKeywordsInAnyCaseGiveTheSameMesh) {
+  TempDir dir;
+  const TriangleMesh cube = Cube();
+  WriteBytes(dir.File("lower.stl"), AsciiStl(cube, {"solid", "facet normal", "outer loop", "vertex",
+                                                    "endloop", "endfacet", "endsolid"}));
+  WriteBytes(dir.File("upper.stl"), AsciiStl(cube, {"SOLID", "FACET NORMAL", "OUTER LOOP", "VERTEX",
+                                                    "ENDLOOP", "ENDFACET", "ENDSOLID"}));
+  WriteBytes(dir.File("mixed.stl"), AsciiStl(cube, {"Solid", "Facet Normal", "Outer Loop", "Vertex",
+                                                    "EndLoop", "EndFacet", "EndSolid"}));
+  auto lower = ReadMesh(dir.File("lower.stl"));
+  ASSERT_TRUE(lower.ok()) << lower.status();
+  ASSERT_EQ(lower->num_triangles(), 12u);
+  EXPECT_EQ(lower->vertices.size(), 8u);
+  for (const char* name : {"upper.stl", "mixed.stl"}) {
+    SCOPED_TRACE(name);
+    auto other = ReadMesh(dir.File(name));
+    ASSERT_TRUE(other.ok()) << other.status();
+    ASSERT_EQ(other->vertices.size(), lower->vertices.size());
+    for (std::size_t v = 0; v < lower->vertices.size(); ++v)
+      EXPECT_EQ(other->vertices[v], lower->vertices[v]) << "vertex " << v;
+    EXPECT_EQ(other->triangles, lower->triangles);
+  }
+}
+
 TEST(ReadMesh, Off) {
   TempDir dir;
   WriteBytes(dir.File("t.off"), "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n");

@@ -48,13 +48,54 @@ TEST(CheckStl, RefusesWithTheFacetAndTheReason) {
   ExpectRefused(CheckStl("solid x\n vertex 1 2 3\nendsolid\n", {}, "p.stl"), "p.stl",
                 "expected 'facet' or 'endsolid'");
   ExpectRefused(CheckStl(BinaryStl(1000, 2), {}, "p.stl"), "p.stl",
-                "binary STL declares 1000 triangles (50084 bytes), the file has 184");
-  ExpectRefused(CheckStl("abc", {}, "p.stl"), "p.stl", "too short");
+                "neither ASCII STL (no 'solid' at the start) nor binary STL: size 184 does not "
+                "match 84 + 50 * 1000 = 50084");
+  ExpectRefused(CheckStl("abc", {}, "p.stl"), "p.stl", "size 3 is under the 84-byte header");
   MeshReadLimits limits;
   limits.max_triangles = 1;
   EXPECT_EQ(CheckStl(BinaryStl(2, 2), limits).code(), absl::StatusCode::kResourceExhausted);
   EXPECT_EQ(CheckStl("solid a\n" + Facet(3) + Facet(3) + "endsolid a\n", limits).code(),
             absl::StatusCode::kResourceExhausted);
+}
+
+TEST(CheckStl, AcceptsKeywordsInAnyCaseAndLowerCasesOnlyThemForAssimp) {
+  // The solid's name holds keywords and the numbers an upper-case exponent:
+  // both stay as they are.
+  const std::string shouted =
+      "\n  SOLID Part FACET Vertex\r\n FACET NORMAL 0 0 1E+0\n  OUTER Loop\n   VERTEX 0 0 0\n"
+      "   Vertex 1E+1 0 0\n   vErTeX 0 1e1 0\n  ENDLOOP\n ENDFACET\nENDSOLID Part FACET\n";
+  const std::string lowered =
+      "\n  solid Part FACET Vertex\r\n facet normal 0 0 1E+0\n  outer loop\n   vertex 0 0 0\n"
+      "   vertex 1E+1 0 0\n   vertex 0 1e1 0\n  endloop\n endfacet\nendsolid Part FACET\n";
+  EXPECT_TRUE(CheckStl(shouted).ok());
+  std::string bytes = shouted;
+  ASSERT_TRUE(CheckStlForAssimp(&bytes).ok());
+  EXPECT_EQ(bytes, lowered);
+  ExpectRefused(CheckStl("SOLID a\n" + Facet(3) + Facet(4) + "ENDSOLID a\n", {}, "p.stl"), "p.stl",
+                "facet 1 (line 15): has 4 vertices");
+  // A binary STL is left as it is, even with keywords in its header.
+  std::string binary = BinaryStl(1, 1);
+  std::memcpy(binary.data(), "SOLID FACET", 11);
+  bytes = binary;
+  ASSERT_TRUE(CheckStlForAssimp(&bytes).ok());
+  EXPECT_EQ(bytes, binary);
+}
+
+// A file that starts with "solid" but is neither a valid ASCII STL nor a
+// binary STL of its size: both readings are named.
+TEST(CheckStl, NamesBothReadingsOfANearMiss) {
+  std::string binary = BinaryStl(3, 2);  // 184 bytes for 3 declared triangles
+  std::memcpy(binary.data(), "solid exported by CAD", 21);
+  ExpectRefused(CheckStl(binary, {}, "p.stl"), "p.stl",
+                "as ASCII STL: ends without 'endsolid'; as binary STL: size 184 does not match "
+                "84 + 50 * 3 = 234");
+  ExpectRefused(CheckStl("Solid x\n", {}, "p.stl"), "p.stl",
+                "as ASCII STL: ends without 'endsolid'; as binary STL: size 8 is under the "
+                "84-byte header");
+  ExpectRefused(CheckStl("solid x\nfacet normal oops\n" + std::string(100, ' '), {}, "p.stl"),
+                "p.stl",
+                "as ASCII STL: facet 0 (line 2): expected 'normal' and 3 numbers; as binary STL: "
+                "size 126 does not match 84 + 50 * 538976288 = 26948814484");
 }
 
 // Only polygonal statements pass; one that merely starts like a known one

@@ -121,5 +121,57 @@ TEST(ParsePcd, SkipsOtherFieldsAndPaddingAndConvertsDoubles) {
   EXPECT_EQ(c->points[0], Eigen::Vector3f(static_cast<float>(0.1), -2.5f, 1e10f));
 }
 
+// VIEWPOINT is kept in the header in the file's order (tx ty tz, then qw qx
+// qy qz) and never applied to the points.
+TEST(ParsePcdHeader, KeepsTheViewpointWithoutApplyingIt) {
+  const std::string body = "WIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n1 2 3\n4 5 6\n";
+  const std::string bytes = kHead + "VIEWPOINT 12.5 -3 0.25 0.5 -0.5 0.5 0.5\n" + body;
+  auto h = ParsePcdHeader(bytes, {}, "v.pcd");
+  ASSERT_TRUE(h.ok()) << h.status();
+  ASSERT_TRUE(h->viewpoint.has_value());
+  const PcdViewpoint& v = *h->viewpoint;
+  EXPECT_EQ(v.tx, 12.5);
+  EXPECT_EQ(v.ty, -3);
+  EXPECT_EQ(v.tz, 0.25);
+  EXPECT_EQ(v.qw, 0.5);
+  EXPECT_EQ(v.qx, -0.5);
+  EXPECT_EQ(v.qy, 0.5);
+  EXPECT_EQ(v.qz, 0.5);
+  auto c = ParsePcd(bytes);
+  ASSERT_TRUE(c.ok()) << c.status();
+  EXPECT_EQ(c->points[0], Eigen::Vector3f(1, 2, 3));
+  EXPECT_EQ(c->points[1], Eigen::Vector3f(4, 5, 6));
+  auto none = ParsePcdHeader(kHead + body, {}, "n.pcd");
+  ASSERT_TRUE(none.ok()) << none.status();
+  EXPECT_FALSE(none->viewpoint.has_value());
+}
+
+// ReadPcdHeader reads the file's first bytes only, to the same header, or
+// the same refusal when the header runs past 64 KiB (here a DATA line that
+// the first read cuts to "DATA binary").
+TEST(ReadPcdHeader, ReadsTheHeadOfTheFileAsParsePcdHeaderReadsTheWhole) {
+  testing::TempDir dir;
+  const std::string bytes = kHead + "WIDTH 1\nHEIGHT 1\nVIEWPOINT 1 2 3 0 0 0 1\nPOINTS 1\n" +
+                            "DATA binary\n" + std::string(12, '\0');
+  testing::WriteBytes(dir.File("v.pcd"), bytes);
+  auto h = ReadPcdHeader(dir.File("v.pcd"));
+  ASSERT_TRUE(h.ok()) << h.status();
+  ASSERT_TRUE(h->viewpoint.has_value());
+  EXPECT_EQ(h->viewpoint->tz, 3);
+  EXPECT_EQ(h->viewpoint->qz, 1);
+  EXPECT_EQ(h->data_offset, bytes.size() - 12);
+  // The first read, 64 KiB and one byte, ends just after "DATA binary".
+  const std::string dims = "\nWIDTH 1\nHEIGHT 1\nPOINTS 1\n";
+  const std::string pad(64 * 1024 + 1 - kHead.size() - 1 - dims.size() - 11, 'p');
+  const std::string cut =
+      kHead + "#" + pad + dims + "DATA binary_compressed\n" + std::string(100, '\0');
+  ASSERT_EQ(cut.substr(64 * 1024 - 10, 11), "DATA binary");
+  testing::WriteBytes(dir.File("cut.pcd"), cut);
+  auto refused = ReadPcdHeader(dir.File("cut.pcd"));
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.status(), ParsePcd(cut, {}, dir.File("cut.pcd")).status());
+  EXPECT_EQ(ReadPcdHeader(dir.File("missing.pcd")).status().code(), absl::StatusCode::kNotFound);
+}
+
 }  // namespace
 }  // namespace surfinspect

@@ -89,6 +89,8 @@ std::vector<Case> Cases() {
        true},
       {"trailing bytes", Header("", n) + "end_header\n" + rows + "trailing", true},
       {"one grid line", Header("obj_info num_cols 7\n", n) + "end_header\n" + rows, true},
+      {"organized grid",
+       Header("obj_info num_cols 40\nobj_info num_rows 25\n", n) + "end_header\n" + rows, true},
       {"infinite coordinate", Header("", n) + "end_header\n" + inf, true},
       {"grid of other size",
        Header("obj_info num_cols 10\nobj_info num_rows 10\n", n) + "end_header\n" + rows, false},

@@ -5,8 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "core/io/ply_format.h"
 
@@ -122,6 +126,8 @@ TEST(ParsePlyCloud, ReadsEncodingsExtraPropertiesAndRangeGrids) {
       "1 1 1\n2 2 2\n3 3 3\n1 0\n0\n1 2\n1 1\n");
   ASSERT_TRUE(g.ok()) << g.status();
   ASSERT_EQ(g->size(), 4u);
+  EXPECT_EQ(g->width, 2u);
+  EXPECT_EQ(g->height, 2u);
   EXPECT_EQ(g->points[0], Eigen::Vector3f(1, 1, 1));
   EXPECT_FALSE(PointCloud::IsValid(g->points[1]));
   EXPECT_EQ(g->points[2], Eigen::Vector3f(3, 3, 3));
@@ -131,6 +137,81 @@ TEST(ParsePlyCloud, ReadsEncodingsExtraPropertiesAndRangeGrids) {
           "element range_grid 4\nproperty list uchar int vertex_indices\nend_header\n"
           "1 1 1\n2 2 2\n3 3 3\n1 0\n0\n1 3\n1 1\n",
       "range_grid 2: vertex index out of range");
+}
+
+// The Stanford range-scan layout (bunny/data/bun000.ply: obj_info num_cols
+// 512 / num_rows 400, a range_grid of 204800 cells), small: 4 columns, 3
+// rows, cells 1, 6 and 11 empty, the vertices stored in reverse cell order.
+// Cell r is row r / 4, column r % 4 and holds the point (column, row,
+// 100 + r).
+constexpr int kCols = 4, kRows = 3;
+bool EmptyCell(int r) { return r == 1 || r == 6 || r == 11; }
+
+std::string GridHeader(const std::string& format, int vertices) {
+  return "ply\nformat " + format +
+         " 1.0\ncomment a range scan\nobj_info num_cols 4\nobj_info num_rows 3\nelement vertex " +
+         std::to_string(vertices) + "\n" + kXyz +
+         "element range_grid 12\nproperty list uchar int vertex_indices\nend_header\n";
+}
+
+// (ascii, binary little-endian) files of the grid above.
+std::pair<std::string, std::string> RangeGridFiles() {
+  std::vector<int> cells;  // the valid cells, in vertex order
+  for (int r = kCols * kRows - 1; r >= 0; --r)
+    if (!EmptyCell(r)) cells.push_back(r);
+  const int n = static_cast<int>(cells.size());
+  std::string ascii = GridHeader("ascii", n), binary = GridHeader("binary_little_endian", n);
+  for (int r : cells) {
+    const float p[3] = {static_cast<float>(r % kCols), static_cast<float>(r / kCols), 100.f + r};
+    ascii += std::to_string(p[0]) + " " + std::to_string(p[1]) + " " + std::to_string(p[2]) + "\n";
+    binary.append(reinterpret_cast<const char*>(p), 12);
+  }
+  for (int r = 0; r < kCols * kRows; ++r) {
+    const int32_t v =
+        static_cast<int32_t>(std::find(cells.begin(), cells.end(), r) - cells.begin());
+    ascii += EmptyCell(r) ? "0\n" : "1 " + std::to_string(v) + "\n";
+    binary += EmptyCell(r) ? '\0' : '\1';
+    if (!EmptyCell(r)) binary.append(reinterpret_cast<const char*>(&v), 4);
+  }
+  return {ascii, binary};
+}
+
+TEST(ParsePlyCloud, ReadsARangeGridAsAnOrganizedCloudRowByRow) {
+  const auto [ascii, binary] = RangeGridFiles();
+  for (const std::string& bytes : {ascii, binary}) {
+    SCOPED_TRACE(bytes.substr(0, 30));
+    auto c = ParsePlyCloud(bytes);
+    ASSERT_TRUE(c.ok()) << c.status();
+    EXPECT_TRUE(c->organized());
+    EXPECT_EQ(c->width, 4u);
+    EXPECT_EQ(c->height, 3u);
+    ASSERT_EQ(c->size(), 12u);
+    EXPECT_EQ(c->CountValid(), 9u);
+    for (int r = 0; r < kCols * kRows; ++r) {
+      if (EmptyCell(r)) {
+        EXPECT_TRUE(std::isnan(c->points[r].x()) && std::isnan(c->points[r].y()) &&
+                    std::isnan(c->points[r].z()))
+            << "cell " << r;
+      } else {
+        EXPECT_EQ(c->points[r], Eigen::Vector3f(r % kCols, r / kCols, 100.f + r)) << "cell " << r;
+      }
+    }
+  }
+  // Without a range_grid, the vertices are the cells, in order.
+  auto v = ParsePlyCloud(
+      "ply\nformat ascii 1.0\nobj_info num_cols 2\nobj_info num_rows 3\n"
+      "element vertex 6\n" +
+      kXyz + "end_header\n" + "0 0 0\n1 0 1\nnan nan nan\n1 1 3\n0 2 4\n1 2 5\n");
+  ASSERT_TRUE(v.ok()) << v.status();
+  EXPECT_EQ(v->width, 2u);
+  EXPECT_EQ(v->height, 3u);
+  EXPECT_EQ(v->points[3], Eigen::Vector3f(1, 1, 3));
+  EXPECT_FALSE(PointCloud::IsValid(v->points[2]));
+  // One of the two alone leaves the cloud unorganized, as before.
+  auto one = ParsePlyCloud("ply\nformat ascii 1.0\nobj_info num_cols 2\nelement vertex 2\n" + kXyz +
+                           "end_header\n0 0 0\n1 0 1\n");
+  ASSERT_TRUE(one.ok()) << one.status();
+  EXPECT_FALSE(one->organized());
 }
 
 }  // namespace
