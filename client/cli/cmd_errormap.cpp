@@ -11,6 +11,7 @@
 #include "client/cli/db_args.h"
 #include "client/cli/remote_args.h"
 #include "client/jobs/errormap_job.h"
+#include "core/cad/cad_import.h"
 
 namespace surfinspect::cli {
 namespace {
@@ -80,7 +81,16 @@ void AddErrorMapCommand(CLI::App& app) {
       "Signed deviation of a cloud from the CAD mesh (+ above the surface, - below): "
       "coloured PLY, CSV, JSON report, PNG");
   cmd->add_option("--cloud", job.cloud, "measured cloud, world frame (.pcd/.ply)")->required();
-  cmd->add_option("--mesh", job.mesh, "CAD mesh, part frame (.stl/.obj/.ply/.off)")->required();
+  cmd->add_option("--mesh", job.mesh,
+                  "CAD, part frame: a mesh (.stl/.obj/.ply/.off) or STEP/IGES (.step/.stp/.iges/"
+                  ".igs, tessellated and cached: docs/cad.md)")
+      ->required();
+  cmd->add_option("--chord-tolerance", job.cad.tessellation.chord_tolerance_mm,
+                  "STEP/IGES: largest measured tessellation error, mm")
+      ->capture_default_str();
+  job.cad_cache = DefaultCadCache();
+  cmd->add_option("--cad-cache", job.cad_cache, "STEP/IGES: folder of cached tessellations")
+      ->capture_default_str();
   cmd->add_option("--world-from-part", job.world_from_part, "transform JSON (default identity)");
   cmd->add_option("--out", job.ply,
                   "coloured binary PLY; the deviation as float 'scalar_deviation' (CloudCompare) "

@@ -35,5 +35,6 @@ void AddHealthCommand(CLI::App& app);
 void AddErrorMapCommand(CLI::App& app);
 void AddAcceptanceCommand(CLI::App& app);
 void AddTrendCommand(CLI::App& app);
+void AddCadCommand(CLI::App& app);
 
 }  // namespace surfinspect::cli

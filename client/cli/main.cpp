@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
   surfinspect::cli::AddErrorMapCommand(app);
   surfinspect::cli::AddAcceptanceCommand(app);
   surfinspect::cli::AddTrendCommand(app);
+  surfinspect::cli::AddCadCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

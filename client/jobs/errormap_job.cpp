@@ -11,9 +11,11 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "client/cell/cell_config.h"
+#include "client/cell/cell_part.h"
 #include "client/cell/part_files.h"
 #include "client/cell/part_outputs.h"
 #include "client/cell/part_recorder.h"
+#include "core/cad/cad_import.h"
 #include "core/distance/mesh_index.h"
 #include "core/io/io_mesh.h"
 #include "core/io/io_point_cloud.h"
@@ -44,6 +46,7 @@ struct Inputs {
   InspectionPlan plan;
   bool keeps_cloud = false;  // the part frame's cloud would be a bit-identical copy
   double read_seconds = 0;
+  std::optional<ReportCad> cad;  // a STEP/IGES mesh's tessellation
 };
 
 // What either path computed: the per-point result, the report, the PNG.
@@ -65,6 +68,16 @@ void Log(const JobLog& log, const std::string& line) {
 
 absl::StatusOr<Inputs> ReadInputs(const ErrorMapJob& job, const JobLog& log) {
   const auto t0 = Clock::now();
+  Inputs in;
+  // A STEP/IGES part is tessellated (or taken from the cache) first; its
+  // groups are read from the cached OBJ.
+  std::string mesh_path = job.mesh;
+  if (IsCadPath(job.mesh)) {
+    ASSIGN_OR_RETURN(const CadMesh cad, ImportCad(job.mesh, job.cad, job.cad_cache));
+    Log(log, CadSummary(cad.report, cad.from_cache));
+    mesh_path = cad.mesh_path;
+    in.cad = ReportCadOf(cad.report);
+  }
   // Each reader is serial, so the two files are read at once; their errors
   // are still reported in the order below. The cloud's task also reads the
   // pose and decides whether the part frame needs a copy of the cloud (a
@@ -72,7 +85,6 @@ absl::StatusOr<Inputs> ReadInputs(const ErrorMapJob& job, const JobLog& log) {
   absl::StatusOr<PointCloud> cloud_read;
   absl::StatusOr<Eigen::Isometry3d> pose_read = Eigen::Isometry3d::Identity();
   absl::StatusOr<TriangleMesh> mesh_read;
-  Inputs in;
   tbb::parallel_invoke(
       [&] {
         cloud_read = ReadPointCloud(job.cloud);
@@ -80,7 +92,7 @@ absl::StatusOr<Inputs> ReadInputs(const ErrorMapJob& job, const JobLog& log) {
         in.keeps_cloud = cloud_read.ok() && pose_read.ok() &&
                          TransformKeepsCloud(*cloud_read, pose_read->inverse());
       },
-      [&] { mesh_read = ReadMesh(job.mesh); });
+      [&] { mesh_read = ReadMesh(mesh_path); });
   ASSIGN_OR_RETURN(in.cloud_in_world, std::move(cloud_read));
   ASSIGN_OR_RETURN(in.world_from_part, std::move(pose_read));
   if (!job.plan.empty()) {
@@ -91,7 +103,7 @@ absl::StatusOr<Inputs> ReadInputs(const ErrorMapJob& job, const JobLog& log) {
   if (job.plan.empty()) {
     in.plan = PlanFromSettings(job.settings);
   } else {
-    ASSIGN_OR_RETURN(in.plan, ParsePlanForMeshFile(in.plan_json, in.mesh, job.mesh, job.settings));
+    ASSIGN_OR_RETURN(in.plan, ParsePlanForMeshFile(in.plan_json, in.mesh, mesh_path, job.settings));
   }
   in.read_seconds = Seconds(t0);
   Log(log, absl::StrFormat("read %d points and %d triangles in %.3f s", in.cloud_in_world.size(),
@@ -335,6 +347,7 @@ absl::StatusOr<ErrorMapJobResult> RunErrorMapJob(const ErrorMapJob& job, RemoteC
   timing.write_seconds = *ply_seconds + Seconds(t_write);
   timing.total_seconds = Seconds(t0);
   run.report.mesh = mesh_summary;
+  run.report.cad = in.cad;
   run.report.output_frame = job.frame;
   if (!job.report.empty()) {
     files.report_text = ReportText(run.report);

@@ -13,6 +13,7 @@
 
 #include "absl/status/statusor.h"
 #include "client/remote/remote_client.h"
+#include "core/cad/cad_settings.h"
 #include "core/errormap/error_map.h"
 #include "core/history/results_store.h"
 #include "core/pipeline/inspection_report.h"
@@ -30,6 +31,10 @@ struct ErrorMapJob {
   std::string frame = "part";          // coordinates of the PLY and the CSV: "part" | "world"
   int png_axis = -1;                   // merged clouds' view axis: 0 x, 1 y, 2 z, -1 thinnest
   ErrorMapSettings settings;
+  // A STEP/IGES `mesh` is tessellated with these (core/cad/cad_import.h)
+  // and cached in cad_cache.
+  CadSettings cad;
+  std::string cad_cache;
 };
 
 struct ErrorMapJobResult {

@@ -72,6 +72,27 @@ absl::StatusOr<std::string> CadWorkerPath() {
                    "/usr/local/bin and /usr/bin; set SURFINSPECT_CAD_WORKER)"));
 }
 
+absl::StatusOr<CadReport> TessellateCadFile(const std::string& path, const CadSettings& settings,
+                                            const std::string& obj_path,
+                                            const std::string& report_path) {
+  RETURN_IF_ERROR(ValidateCadSettings(settings));
+  ASSIGN_OR_RETURN(const std::string bytes, ReadFileToString(path, settings.limits.max_file_bytes));
+  RETURN_IF_ERROR(RunWorker(path, settings, obj_path, report_path));
+  ASSIGN_OR_RETURN(CadReport report, ReadReport(report_path));
+  report.source_sha256 = Sha256Hex(bytes);
+  return report;
+}
+
+std::string DefaultCadCache() {
+  const char* own = std::getenv("SURFINSPECT_CAD_CACHE");
+  if (own && *own) return own;
+  const char* xdg = std::getenv("XDG_CACHE_HOME");
+  if (xdg && *xdg) return (fs::path(xdg) / "surfinspect" / "cad").string();
+  const char* home = std::getenv("HOME");
+  if (home && *home) return (fs::path(home) / ".cache" / "surfinspect" / "cad").string();
+  return "/tmp/surfinspect-cad-cache";
+}
+
 std::string CadCacheKey(const std::string& file_sha256, const TessellationSettings& s) {
   const std::string settings = absl::StrFormat(
       "chord=%.17g angle=%.17g body=%s v1", s.chord_tolerance_mm, s.angular_tolerance_deg, s.body);

@@ -29,8 +29,20 @@ struct CadMesh {
 // where it looked.
 absl::StatusOr<std::string> CadWorkerPath();
 
+// The cache folder of commands without a cell: $SURFINSPECT_CAD_CACHE, else
+// $XDG_CACHE_HOME/surfinspect/cad, else ~/.cache/surfinspect/cad, else
+// /tmp/surfinspect-cad-cache.
+std::string DefaultCadCache();
+
 // The cache key: the file's SHA-256, then the settings that change the mesh.
 std::string CadCacheKey(const std::string& file_sha256, const TessellationSettings& settings);
+
+// Tessellates `path` into `obj_path` (grouped OBJ, mm) and `report_path`
+// (CadReport JSON) in the worker under settings.limits, without the cache:
+// what `surfinspect cad` does. Errors as ImportCad's.
+absl::StatusOr<CadReport> TessellateCadFile(const std::string& path, const CadSettings& settings,
+                                            const std::string& obj_path,
+                                            const std::string& report_path);
 
 // Reads the cached tessellation or makes it in the worker under
 // settings.limits. Errors name the file: InvalidArgument for a file OCCT

@@ -22,6 +22,7 @@ void VisitCadReport(V& v, R& r) {
   v("passes", r.passes);
   v("tessellation_error_mm", r.tessellation_error_mm);
   v("tolerance_held", r.tolerance_held);
+  v("brep_tolerance_mm", r.brep_tolerance_mm);
   v("bounds_min_mm", r.bounds_mm.min);
   v("bounds_max_mm", r.bounds_mm.max);
   v("seconds", r.seconds);

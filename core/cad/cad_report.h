@@ -33,10 +33,13 @@ struct CadReport {
   std::size_t faces = 0, triangles = 0;
   double chord_tolerance_mm = 0;
   double angular_tolerance_deg = 0;
-  double deflection_mm = 0;           // OCCT's deflection on the last pass
-  int passes = 0;                     // meshing passes (1 + refinements)
-  double tessellation_error_mm = 0;   // measured, the largest over faces
-  bool tolerance_held = false;        // tessellation_error_mm <= chord_tolerance_mm
+  double deflection_mm = 0;          // OCCT's deflection on the last pass
+  int passes = 0;                    // meshing passes (1 + refinements)
+  double tessellation_error_mm = 0;  // measured, the largest over faces
+  bool tolerance_held = false;       // tessellation_error_mm <= chord_tolerance_mm
+  // The file's largest edge tolerance (its curves' gap to their surfaces):
+  // when the measured error stalls near it, finer meshing cannot help.
+  double brep_tolerance_mm = 0;
   std::vector<double> face_error_mm;  // per face, in the order of the groups face:1..
   Bounds3 bounds_mm;                  // of the mesh
   double seconds = 0;                 // read, mesh and measure

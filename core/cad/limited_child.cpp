@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
@@ -29,6 +30,7 @@ constexpr std::size_t kKeptStderr = 4096;
   ::setrlimit(RLIMIT_AS, &as);
   ::setrlimit(RLIMIT_CORE, &core);
   ::dup2(err_fd, STDERR_FILENO);
+  ::dup2(err_fd, STDOUT_FILENO);  // OpenCASCADE prints its messages on stdout
   ::execv(argv[0], argv);
   _exit(127);
 }
@@ -52,16 +54,34 @@ bool DrainUntil(int fd, std::chrono::steady_clock::time_point deadline, std::str
   }
 }
 
+// ESC [ ... letter: a terminal's colour code, as OCCT's messages carry.
+std::string WithoutEscapes(const std::string& text) {
+  std::string out;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text[i] != '\x1b') {
+      out += text[i];
+      continue;
+    }
+    if (i + 1 < text.size() && text[i + 1] == '[')
+      for (i += 2; i < text.size() && !std::isalpha(static_cast<unsigned char>(text[i])); ++i) {
+      }
+  }
+  return out;
+}
+
 std::string LastLines(const std::string& text) {
-  std::string t(absl::StripTrailingAsciiWhitespace(text));
+  std::string t(absl::StripAsciiWhitespace(WithoutEscapes(text)));
   if (t.size() > kKeptStderr) t = t.substr(t.size() - kKeptStderr);
   return t.empty() ? "" : absl::StrCat(": ", t);
 }
 
 absl::Status StatusOfExit(int wstatus, const std::string& err, const ChildLimits& limits,
                           const std::string& what) {
-  const bool out_of_memory =
-      err.find("bad_alloc") != std::string::npos || err.find("OutOfMemory") != std::string::npos;
+  // Under RLIMIT_AS a thread that cannot get its stack fails pthread_create:
+  // OCCT's mesher threads then abort the child, which is the memory limit too.
+  const bool out_of_memory = err.find("bad_alloc") != std::string::npos ||
+                             err.find("OutOfMemory") != std::string::npos ||
+                             err.find("pthread_create") != std::string::npos;
   if (WIFSIGNALED(wstatus)) {
     if (out_of_memory)
       return absl::ResourceExhaustedError(absl::StrCat(what, " ran out of its ", limits.memory_mb,
@@ -75,7 +95,11 @@ absl::Status StatusOfExit(int wstatus, const std::string& err, const ChildLimits
   if (code == 3 || out_of_memory)
     return absl::ResourceExhaustedError(absl::StrCat(what, " ran out of its ", limits.memory_mb,
                                                      " MB memory limit", LastLines(err)));
-  if (code == 127) return absl::NotFoundError(absl::StrCat(what, ": cannot run the program"));
+  if (code == 127)
+    return absl::NotFoundError(absl::StrCat(what,
+                                            ": the program could not start (not executable, "
+                                            "or it does not load within ",
+                                            limits.memory_mb, " MB)"));
   if (code == 2) return absl::InvalidArgumentError(absl::StrCat(what, " failed", LastLines(err)));
   return absl::FailedPreconditionError(
       absl::StrCat(what, " failed (exit code ", code, ")", LastLines(err)));

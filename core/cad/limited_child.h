@@ -18,7 +18,9 @@ struct ChildLimits {
   uint64_t memory_mb = 4096;  // RLIMIT_AS
 };
 
-// Runs argv[0] (a path) with argv. OK when it exits 0. Otherwise:
+// Runs argv[0] (a path) with argv; its stdout and stderr are one pipe, the
+// tail of which (terminal colour codes removed) ends every error message.
+// OK when it exits 0. Otherwise:
 //   DeadlineExceeded  "<what> took longer than N s and was stopped"
 //   ResourceExhausted "<what> ran out of its N MB memory limit" (exit code 3
 //                     by convention, or an out-of-memory message on stderr)

@@ -4,7 +4,11 @@
 
 #include <BRepMesh_IncrementalMesh.hxx>
 #include <BRepTools.hxx>
+#include <BRep_Tool.hxx>
 #include <Standard_Failure.hxx>
+#include <Standard_OutOfMemory.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopoDS.hxx>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -35,6 +39,16 @@ std::vector<MeshedFace> MeshAndMeasure(const OcctModel& model, double deflection
 double Worst(const std::vector<MeshedFace>& faces) {
   double worst = 0;
   for (const MeshedFace& f : faces) worst = std::max(worst, f.error_mm);
+  return worst;
+}
+
+// The B-rep's own gap between an edge's curve and its faces' surfaces, as
+// the file states it: a floor under any measured tessellation error.
+double LargestEdgeTolerance(const OcctModel& model) {
+  double worst = 0;
+  for (const ModelFace& f : model.faces)
+    for (TopExp_Explorer e(f.face, TopAbs_EDGE); e.More(); e.Next())
+      worst = std::max(worst, BRep_Tool::Tolerance(TopoDS::Edge(e.Current())));
   return worst;
 }
 
@@ -77,17 +91,20 @@ absl::StatusOr<CadTessellation> Tessellate(const std::string& path,
   double deflection = tol;
   std::vector<MeshedFace> faces;
   int passes = 0;
+  double previous = INFINITY;
   for (;;) {
     faces = MeshAndMeasure(*model, deflection, settings.angular_tolerance_deg, tol);
     ++passes;
     const double worst = Worst(faces);
+    const bool stalled = worst > 0.9 * previous;  // finer meshing no longer helps
+    previous = worst;
     std::size_t triangles = 0, over = 0;
     for (const MeshedFace& f : faces) triangles += f.triangles.size(), over += f.error_mm > tol;
     std::fprintf(
         stderr,
         "pass %d: deflection %.3g mm, %zu triangles, measured %.3g mm, %zu faces over %.3g mm\n",
         passes, deflection, triangles, worst, over, tol);
-    if (worst <= tol || passes == kMaxPasses) break;
+    if (worst <= tol || passes == kMaxPasses || stalled) break;
     // The chord error of a smooth surface grows about linearly with the
     // deflection asked for: aim 20% under the tolerance, cut at most 10x.
     deflection *= std::clamp(0.8 * tol / worst, 0.1, 0.8);
@@ -109,6 +126,7 @@ absl::StatusOr<CadTessellation> Tessellate(const std::string& path,
   for (const MeshedFace& f : faces) r.face_error_mm.push_back(f.error_mm);
   r.tessellation_error_mm = Worst(faces);
   r.tolerance_held = r.tessellation_error_mm <= tol;
+  r.brep_tolerance_mm = LargestEdgeTolerance(*model);
   r.bounds_mm = ComputeBounds(out.mesh);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (out.mesh.triangles.empty())
@@ -123,6 +141,8 @@ absl::StatusOr<CadTessellation> TessellateCad(const std::string& path,
                                               const TessellationSettings& settings) {
   try {
     return Tessellate(path, settings);
+  } catch (const Standard_OutOfMemory&) {
+    return absl::ResourceExhaustedError(path + ": out of memory in OpenCASCADE");
   } catch (const Standard_Failure& e) {
     return absl::InvalidArgumentError(path + ": OpenCASCADE failed: " + e.GetMessageString() +
                                       " (" + e.DynamicType()->Name() + ")");

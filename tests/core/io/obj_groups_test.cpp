@@ -53,17 +53,36 @@ int SquareOf(const TriangleMesh& m, std::size_t t) {
 }
 
 TEST(ObjGroups, EveryTriangleLandsInTheGroupOfItsFace) {
-  // Squares at x = 0..5: none, a, b, a (reopened), c (by `o`), none (bare g).
+  // Squares at x = 0..5: none, a, b and extra, a (reopened), c (by `o`),
+  // none (bare g). A `g` with several names puts its faces in each of them.
   const Read r = ReadObj(Quad(0) + "g a\n" + Quad(1) + "g b extra\n" + Pentagon(2) + "g a\n" +
                          Quad(3) + "o c\n" + Quad(4) + "g\n" + Quad(5));
   ASSERT_TRUE(r.groups.ok()) << r.groups.status();
-  EXPECT_EQ(r.groups->names, (std::vector<std::string>{"a", "b", "c"}));
+  EXPECT_EQ(r.groups->names, (std::vector<std::string>{"a", "b", "extra", "c"}));
   ASSERT_EQ(r.groups->triangle_group.size(), r.mesh.num_triangles());
   ASSERT_EQ(r.mesh.num_triangles(), 2u * 5 + 3);
   const uint32_t none = MeshGroups::kNoGroup;
-  const uint32_t expected[] = {none, 0, 1, 0, 2, none};
+  const uint32_t expected[] = {none, 0, 1, 0, 3, none};
+  std::size_t in_extra = 0;
+  for (std::size_t t = 0; t < r.mesh.num_triangles(); ++t) {
+    const int square = SquareOf(r.mesh, t);
+    EXPECT_EQ(r.groups->triangle_group[t], expected[square]) << "triangle " << t;
+    EXPECT_EQ(r.groups->Contains(static_cast<uint32_t>(t), 2), square == 2) << "triangle " << t;
+    EXPECT_EQ(r.groups->Contains(static_cast<uint32_t>(t), 1), square == 2) << "triangle " << t;
+    in_extra += r.groups->Contains(static_cast<uint32_t>(t), 2);
+  }
+  EXPECT_EQ(in_extra, 3u);
+}
+
+// surfinspect cad names colour groups `color:#rrggbb`: a '#' inside a name
+// is part of it, a '#' that starts a token begins a comment.
+TEST(ObjGroups, AHashInsideANameIsPartOfItAndStartsACommentOnlyAtATokensStart) {
+  const Read r =
+      ReadObj("g face:1 color:#ff0000 # the red face\n" + Quad(0) + "#g hidden\n" + Quad(1));
+  ASSERT_TRUE(r.groups.ok()) << r.groups.status();
+  EXPECT_EQ(r.groups->names, (std::vector<std::string>{"face:1", "color:#ff0000"}));
   for (std::size_t t = 0; t < r.mesh.num_triangles(); ++t)
-    EXPECT_EQ(r.groups->triangle_group[t], expected[SquareOf(r.mesh, t)]) << "triangle " << t;
+    EXPECT_EQ(r.groups->Contains(static_cast<uint32_t>(t), 1), SquareOf(r.mesh, t) <= 1);
 }
 
 TEST(ObjGroups, FileWithoutGroupsHasNone) {
