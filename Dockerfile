@@ -1,5 +1,6 @@
 # surfinspect container image: surfinspectd (the default command), the
-# surfinspect CLI and cell-agent. Two stages:
+# surfinspect CLI, cell-agent and surfinspect-cad-worker (STEP/IGES parts,
+# run by the CLI and the agent as a limited child; docs/cad.md). Two stages:
 #   build    debian:bookworm       the README's own `./run deps` + `./run build`
 #   runtime  debian:bookworm-slim  only the shared libraries the binaries link
 #                                  (tests/deploy/deploy_files_test.py checks
@@ -15,7 +16,8 @@ RUN ./run deps && rm -rf /var/lib/apt/lists/*
 COPY . .
 # Tests are not shipped; `./run build` passes extra arguments on to CMake.
 RUN ./run build -DBUILD_TESTING=OFF \
- && strip build/bin/surfinspectd build/bin/surfinspect build/bin/cell-agent
+ && strip build/bin/surfinspectd build/bin/surfinspect build/bin/cell-agent \
+          build/bin/surfinspect-cad-worker
 
 FROM debian:bookworm-slim AS runtime
 RUN apt-get update \
@@ -25,11 +27,13 @@ RUN apt-get update \
       libprometheus-cpp-pull1.0 libprotobuf32 libpugixml1v5 libspdlog1.10 libssl3 libstdc++6 \
       libtbb12 libcairo2 libglib2.0-0 libpango-1.0-0 libpangocairo-1.0-0 fonts-dejavu-core \
       libsqlite3-0 libpqxx-6.4 libpq5 zlib1g \
+      libocct-foundation-7.6 libocct-modeling-data-7.6 libocct-modeling-algorithms-7.6 \
+      libocct-data-exchange-7.6 libocct-ocaf-7.6 \
  && rm -rf /var/lib/apt/lists/*
 RUN useradd --system --uid 10001 --user-group --home-dir /var/lib/surfinspect --create-home \
       --shell /usr/sbin/nologin surfinspect
 COPY --from=build /src/build/bin/surfinspectd /src/build/bin/surfinspect /src/build/bin/cell-agent \
-     /usr/local/bin/
+     /src/build/bin/surfinspect-cad-worker /usr/local/bin/
 COPY --from=build /src/proto /usr/local/share/surfinspect/proto
 # Numeric, so Kubernetes' runAsNonRoot can verify it.
 USER 10001:10001

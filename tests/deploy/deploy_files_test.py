@@ -28,6 +28,8 @@ import yaml
 SRC = BIN = None
 GRPC_PORT, METRICS_PORT = 50051, 9464
 HEALTH_SERVICE = "surfinspect.v1.InspectionService"
+# What the image ships: the CLI and the agent run the CAD worker beside them.
+BINARIES = ("surfinspectd", "surfinspect", "cell-agent", "surfinspect-cad-worker")
 
 
 def load_yaml(*parts):
@@ -295,7 +297,7 @@ class DockerfileTest(unittest.TestCase):
         self.assertEqual(len(health), 1)
         self.assertRegex(health[0], r'CMD \["surfinspect", "health", "--server", "127\.0\.0\.1:50051"\]')
         copied = " ".join(a for k, a in rt if k == "COPY" and a.startswith("--from=build"))
-        for b in ("surfinspectd", "surfinspect", "cell-agent"):
+        for b in BINARIES:
             self.assertIn(f"/src/build/bin/{b} ", copied + " ")
         self.assertEqual([a for k, a in rt if k == "ENTRYPOINT"], ['["surfinspectd"]'])
         with open(os.path.join(SRC, ".dockerignore")) as f:
@@ -315,7 +317,7 @@ class DockerfileTest(unittest.TestCase):
         packages = self.runtime_packages()
         essential = {"libc6", "libgcc-s1"}  # in every Debian image
         needs = {}  # resolved library path -> (binary, soname)
-        for b in ("surfinspectd", "surfinspect", "cell-agent"):
+        for b in BINARIES:
             path = os.path.join(BIN, b)
             needed = re.findall(r"\(NEEDED\)\s+Shared library: \[(.+?)\]",
                                 subprocess.run(["readelf", "-d", path], capture_output=True, text=True).stdout)
