@@ -4,6 +4,8 @@
 #include <filesystem>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
+#include "client/cell/cell_part.h"
 #include "client/cell/part_outputs.h"
 #include "client/cell/report_context.h"
 #include "core/io/disk_space.h"
@@ -117,7 +119,7 @@ PartReport CellAgent::QuarantinePart(const std::string& id, std::string why) {
 std::shared_ptr<const TriangleMesh> CellAgent::PartMesh() {
   if (!part_mesh_read_) {
     part_mesh_read_ = true;
-    if (auto mesh = ReadMesh(cell_.part_mesh); mesh.ok())
+    if (auto mesh = ReadCellPartMesh(cell_); mesh.ok())
       part_mesh_ = std::make_shared<const TriangleMesh>(*std::move(mesh));
   }
   return part_mesh_;
@@ -151,10 +153,11 @@ PartReport CellAgent::ArchiveWithoutCall(const std::string& id) {
 }
 
 bool CellAgent::ReadViews(const std::string& id, std::vector<ViewScan>* views, PartReport* report) {
+  std::vector<std::string> doubts;
   for (const auto& vp : cell_.viewpoints) {
     const std::string path = (fs::path(layout_.inbox) / id / (vp.name + ".pcd")).string();
     if (!fs::exists(path)) continue;
-    auto cloud = ReadPointCloud(path);
+    auto cloud = ReadCellScan(cell_, path, PartMesh().get(), &doubts);
     if (!cloud.ok()) {
       *report = QuarantinePart(id, std::string(cloud.status().message()));
       return false;
@@ -169,6 +172,11 @@ bool CellAgent::ReadViews(const std::string& id, std::vector<ViewScan>* views, P
   }
   if (views->empty()) {
     *report = QuarantinePart(id, "no <viewpoint>.pcd scan of this cell's viewpoints");
+    return false;
+  }
+  // Units in doubt would give deviations off by their factor: never judged.
+  if (!doubts.empty()) {
+    *report = QuarantinePart(id, absl::StrCat("units in doubt: ", absl::StrJoin(doubts, "; ")));
     return false;
   }
   return true;
@@ -207,6 +215,7 @@ PartReport CellAgent::InspectAndStore(const std::string& id, const std::vector<V
       outputs->mesh_in_part = PartMesh();
       outputs->viewpoints = ViewpointCalibrations(cell_);
       if (cell_.part_cad) outputs->cad = ReportCadOf(*cell_.part_cad);
+      outputs->input_units = CellInputUnits(cell_, {});
     }
     uint64_t bytes = 0;
     absl::Status written = outputs.ok()

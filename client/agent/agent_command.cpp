@@ -284,7 +284,7 @@ absl::StatusOr<RunOutcome> RunCellCommand(const AgentArgs& a, const AgentOutput&
   ASSIGN_OR_RETURN(const RobotDrift drift, RobotDriftOf(a));
   RETURN_IF_ERROR(SimulateIfAsked(a, cell, layout, drift, out));
   ASSIGN_OR_RETURN(const TriangleMesh part, part_ok.ok()
-                                                ? ReadMesh(cell.part_mesh)
+                                                ? ReadCellPartMesh(cell)
                                                 : absl::StatusOr<TriangleMesh>(TriangleMesh{}));
   ASSIGN_OR_RETURN(const std::optional<InspectionPlan> plan,
                    part_ok.ok() ? PlanOf(cell, part, cell.error_map)
@@ -340,7 +340,7 @@ absl::StatusOr<PruneResult> RunPruneCommand(const AgentArgs& a, const AgentOutpu
         absl::StrCat(cell.path, ": no \"retention\" rule, nothing to prune (docs/cell-agent.md)"));
   const InboxLayout layout = ResolveLayout(a.paths);
   RETURN_IF_ERROR(LoadCellPart(&cell, nullptr));
-  ASSIGN_OR_RETURN(const TriangleMesh part, ReadMesh(cell.part_mesh));
+  ASSIGN_OR_RETURN(const TriangleMesh part, ReadCellPartMesh(cell));
   ASSIGN_OR_RETURN(const std::unique_ptr<StoreRecorder> recorder,
                    MakeRecorder(a, cell, layout, part, out));
   ASSIGN_OR_RETURN(const MqttSettings mqtt, MqttSettingsFromCell(cell));

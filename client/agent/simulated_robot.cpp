@@ -10,6 +10,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
+#include "client/cell/cell_part.h"
 #include "core/io/atomic_file.h"
 #include "core/io/io_mesh.h"
 #include "core/io/io_point_cloud.h"
@@ -255,7 +256,7 @@ absl::StatusOr<std::vector<std::string>> SimulateParts(const CellConfig& cell,
                                                        const std::string& inbox, int count,
                                                        uint64_t seed, const SurfaceDrift& drift,
                                                        const RobotDrift& robot) {
-  ASSIGN_OR_RETURN(auto part, ReadMesh(cell.part_mesh));
+  ASSIGN_OR_RETURN(auto part, ReadCellPartMesh(cell));
   std::mt19937_64 rng(seed);
   std::vector<std::string> ids;
   for (int k = 0, n = 1; k < count; ++n) {

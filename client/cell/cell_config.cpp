@@ -112,6 +112,34 @@ absl::Status ReadSettings(const nlohmann::json& j, CellConfig& c) {
   return st;
 }
 
+// The "units" of `o` (a cell.json object), else `fallback`.
+absl::StatusOr<InputUnit> UnitAt(const nlohmann::json& o, const std::string& where,
+                                 const InputUnit& fallback) {
+  if (!o.is_object() || !o.contains("units")) return fallback;
+  const absl::StatusOr<InputUnit> u = o["units"].is_string()
+                                          ? InputUnitOf(o["units"].get<std::string>())
+                                          : absl::InvalidArgumentError("must be a string");
+  if (!u.ok() || !u->stated)
+    return absl::InvalidArgumentError(absl::StrCat(
+        where, ": ", u.ok() ? "must not be empty" : u.status().message(), " (mm, cm, m or in)"));
+  return *u;
+}
+
+// "units" for the scans and the part, "sensor.units" and "part.units" for
+// each; a STEP/IGES part is read in millimetres whatever its file's unit.
+absl::Status ReadUnits(const nlohmann::json& j, CellConfig& c) {
+  ASSIGN_OR_RETURN(const InputUnit all, UnitAt(j, "units", InputUnit{}));
+  ASSIGN_OR_RETURN(c.sensor_units, UnitAt(j.contains("sensor") ? j["sensor"] : nlohmann::json(),
+                                          "sensor.units", all));
+  ASSIGN_OR_RETURN(c.part_units, UnitAt(j["part"], "part.units", all));
+  if (!IsCadPath(c.part_source)) return absl::OkStatus();
+  if (j["part"].contains("units"))
+    return absl::InvalidArgumentError(
+        "part.units: a STEP/IGES part declares its own unit; it is read in millimetres");
+  c.part_units = InputUnit{LengthUnit::kMillimetre, true};
+  return absl::OkStatus();
+}
+
 // "cad": how a STEP/IGES part is tessellated; validated by ValidateCadSettings.
 absl::Status ReadCad(const std::string& path, const nlohmann::json& j, CellConfig& c) {
   c.cad_cache = (std::filesystem::path(path).parent_path() / ".cad-cache").string();
@@ -203,6 +231,7 @@ absl::StatusOr<CellConfig> ReadCellConfig(const std::string& path) {
     }
     if (auto st = ReadSettings(j, c); !st.ok()) return Bad(path, st.message());
     if (auto st = ReadCad(path, j, c); !st.ok()) return Bad(path, st.message());
+    if (auto st = ReadUnits(j, c); !st.ok()) return Bad(path, st.message());
     if (j.contains("plan")) {
       if (j["plan"].is_string()) {
         c.plan_source = Resolve(path, j["plan"].get<std::string>());
@@ -245,7 +274,8 @@ absl::StatusOr<std::optional<InspectionPlan>> PlanOf(const CellConfig& cell,
                                                      const TriangleMesh& part,
                                                      const ErrorMapSettings& settings) {
   if (!cell.plan) return std::optional<InspectionPlan>();
-  auto plan = ParsePlanForMeshFile(*cell.plan, part, cell.part_mesh, settings);
+  auto plan = ParsePlanForMeshFile(*cell.plan, part, cell.part_mesh, settings, "plan",
+                                   cell.part_units.unit);
   if (!plan.ok()) return Bad(cell.plan_source, plan.status().message());
   return std::optional<InspectionPlan>(*std::move(plan));
 }

@@ -43,6 +43,7 @@
 #include "core/cad/cad_settings.h"
 #include "core/errormap/error_map.h"
 #include "core/filter/link_clustering.h"
+#include "core/io/length_units.h"
 #include "core/pipeline/inspection.h"
 
 namespace surfinspect::client {
@@ -70,6 +71,11 @@ struct CellConfig {
   std::string cad_cache;
   std::string part_source;
   std::optional<CadReport> part_cad;
+  // The units of the scans and of the part mesh: "units" for both, or
+  // "sensor.units" / "part.units" (docs/units.md). Absent = millimetres
+  // assumed, and checked by core/io/unit_doubt.h. A STEP/IGES part declares
+  // its own unit. Transforms are millimetres.
+  InputUnit sensor_units, part_units;
   Eigen::Isometry3d world_from_part = Eigen::Isometry3d::Identity();
   std::vector<CellViewpoint> viewpoints;
   ErrorMapSettings error_map;
@@ -94,7 +100,8 @@ InspectionSettings InspectionSettingsOf(const CellConfig& cell);
 // against a mesh by ParsePlanWithDefaults.
 absl::StatusOr<nlohmann::json> ReadPlanJson(const std::string& path);
 
-// The cell's plan parsed against `part` with `settings` as its defaults
+// The cell's plan parsed against `part` (in millimetres: ReadCellPartMesh,
+// client/cell/cell_part.h) with `settings` as its defaults
 // (core/plan/plan_evaluation.h), or unset when the cell has none.
 // InvalidArgument "<file>: plan.<field>: ..." for a bad plan.
 absl::StatusOr<std::optional<InspectionPlan>> PlanOf(const CellConfig& cell,

@@ -2,6 +2,9 @@
 
 #include "absl/strings/str_format.h"
 #include "core/cad/cad_import.h"
+#include "core/io/io_mesh.h"
+#include "core/io/io_point_cloud.h"
+#include "core/io/unit_doubt.h"
 
 namespace surfinspect::client {
 
@@ -24,6 +27,35 @@ absl::Status LoadCellPart(CellConfig* cell, std::string* log) {
   cell->part_cad = cad->report;
   if (log) *log = CadSummary(cad->report, cad->from_cache);
   return absl::OkStatus();
+}
+
+absl::StatusOr<TriangleMesh> ReadCellPartMesh(const CellConfig& cell) {
+  absl::StatusOr<TriangleMesh> mesh = ReadMesh(cell.part_mesh);
+  if (mesh.ok()) ScaleToMillimetres(cell.part_units.unit, &*mesh);
+  return mesh;
+}
+
+absl::StatusOr<PointCloud> ReadCellScan(const CellConfig& cell, const std::string& path,
+                                        const TriangleMesh* part,
+                                        std::vector<std::string>* doubts) {
+  absl::StatusOr<PointCloud> cloud = ReadPointCloud(path);
+  if (!cloud.ok()) return cloud;
+  ScaleToMillimetres(cell.sensor_units.unit, &*cloud);
+  if (cell.sensor_units.stated && cell.part_units.stated) return cloud;
+  const UnitSubject scan{"scan " + path, "cell.json's sensor.units =", ExtentOf(*cloud),
+                         cell.sensor_units.stated};
+  std::optional<UnitSubject> mesh;
+  if (part)
+    mesh = UnitSubject{"part " + cell.part_mesh, "cell.json's part.units =", ExtentOf(*part),
+                       cell.part_units.stated};
+  for (std::string& d : UnitDoubts(scan, mesh ? &*mesh : nullptr))
+    if (std::find(doubts->begin(), doubts->end(), d) == doubts->end()) doubts->push_back(d);
+  return cloud;
+}
+
+ReportInputUnits CellInputUnits(const CellConfig& cell, std::vector<std::string> doubts) {
+  return {LengthUnitName(cell.sensor_units.unit), LengthUnitName(cell.part_units.unit),
+          cell.sensor_units.stated, cell.part_units.stated, std::move(doubts)};
 }
 
 }  // namespace surfinspect::client

@@ -117,6 +117,7 @@ absl::Status WritePartOutputs(const std::string& dir, const PartOutputs& o,
                               const PartFileSet& files, uint64_t* bytes) {
   ASSIGN_OR_RETURN(InspectionReport report, ParseReport(o.report_json));
   report.cad = o.cad;
+  report.input_units = o.input_units;
   // The PLY/CSV writers only read deviations, tolerance and colour range.
   ErrorMapResult view;
   view.deviation_mm = o.deviation_mm;
@@ -132,8 +133,9 @@ absl::Status WritePartOutputs(const std::string& dir, const PartOutputs& o,
   in.points_in_part = &in_part;
   in.error_map = &view;
   in.report = &report;
-  // Decoding then encoding gives the same text, so the text changes only by "cad".
-  in.report_text = o.cad ? ReportText(report) : o.report_json;
+  // Decoding then encoding gives the same text, so the text changes only by
+  // "cad" and "input_units".
+  in.report_text = o.cad || o.input_units ? ReportText(report) : o.report_json;
   in.png = o.png;
   in.mesh_in_part = o.mesh_in_part.get();
   in.viewpoints = o.viewpoints;

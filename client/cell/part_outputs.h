@@ -41,6 +41,8 @@ struct PartOutputs {
   // The part's tessellation when it came from STEP/IGES: written into
   // report.json as "cad" (the server never sees the STEP file).
   std::optional<ReportCad> cad;
+  // The units the scans and the part were read in (report.json "input_units").
+  std::optional<ReportInputUnits> input_units;
 };
 
 // The lines of PartOutputs::failed and ::defects.

@@ -10,6 +10,7 @@
 #include "client/cli/commands.h"
 #include "client/cli/db_args.h"
 #include "client/cli/remote_args.h"
+#include "client/cli/unit_args.h"
 #include "client/jobs/errormap_job.h"
 #include "core/cad/cad_import.h"
 
@@ -21,6 +22,7 @@ struct ErrorMapArgs {
   std::string png_axis = "auto";
   std::string db;
   RemoteArgs remote;
+  UnitArgs units;
 };
 
 void PrintSummary(const ErrorMapArgs& a, const client::ErrorMapJobResult& r) {
@@ -33,6 +35,11 @@ void PrintSummary(const ErrorMapArgs& a, const client::ErrorMapJobResult& r) {
   std::printf("percentiles mm: p1 %.4f  p5 %.4f  p50 %.4f  p95 %.4f  p99 %.4f\n", st.p1_mm,
               st.p5_mm, st.p50_mm, st.p95_mm, st.p99_mm);
   std::printf("verdict: %s\n", r.report.tolerance.reason.c_str());
+  if (r.report.input_units && !r.report.input_units->doubts.empty())
+    std::printf(
+        "units: DOUBTED (%zu warning(s) on stderr): the deviations may be off by the "
+        "unit's factor; state the units to judge this part\n",
+        r.report.input_units->doubts.size());
   if (!job.plan.empty()) {
     std::printf("part: %s (%zu characteristics, %zu defects)\n",
                 r.report.verdict.empty() ? "?" : r.report.verdict.c_str(),
@@ -51,6 +58,8 @@ void RunErrorMap(ErrorMapArgs& a) {
   job.png_axis = a.png_axis == "x" ? 0 : a.png_axis == "y" ? 1 : a.png_axis == "z" ? 2 : -1;
   // Bad parameters are refused before any file is read.
   Check(ValidateErrorMapSettings(job.settings));
+  job.cloud_units = a.units.Cloud();
+  job.mesh_units = a.units.Mesh();
   const std::unique_ptr<ResultsStore> store = a.db.empty() ? nullptr : OpenStore(a.db, false);
   const std::unique_ptr<client::RemoteClient> remote =
       a.remote.remote() ? Connect(a.remote) : nullptr;
@@ -61,8 +70,9 @@ void RunErrorMap(ErrorMapArgs& a) {
                                                  : tbb::task_arena::automatic);
   absl::StatusOr<client::ErrorMapJobResult> result;
   arena.execute([&] {
-    result = client::RunErrorMapJob(job, remote.get(), store.get(),
-                                    [](const std::string& line) { spdlog::info("{}", line); });
+    result = client::RunErrorMapJob(
+        job, remote.get(), store.get(), [](const std::string& line) { spdlog::info("{}", line); },
+        WarnUnitDoubt);
   });
   const client::ErrorMapJobResult r = Take(std::move(result));
   PrintSummary(a, r);
@@ -91,7 +101,9 @@ void AddErrorMapCommand(CLI::App& app) {
   job.cad_cache = DefaultCadCache();
   cmd->add_option("--cad-cache", job.cad_cache, "STEP/IGES: folder of cached tessellations")
       ->capture_default_str();
-  cmd->add_option("--world-from-part", job.world_from_part, "transform JSON (default identity)");
+  AddUnitOptions(cmd, a->units, /*with_mesh=*/true);
+  cmd->add_option("--world-from-part", job.world_from_part,
+                  "transform JSON (mm; default identity)");
   cmd->add_option("--out", job.ply,
                   "coloured binary PLY; the deviation as float 'scalar_deviation' (CloudCompare) "
                   "and 'quality' (MeshLab)")

@@ -13,6 +13,7 @@
 #include "client/cli/commands.h"
 #include "client/cli/db_args.h"
 #include "client/cli/remote_args.h"
+#include "client/cli/unit_args.h"
 #include "core/io/io_mesh.h"
 #include "core/io/io_point_cloud.h"
 #include "core/pipeline/inspection.h"
@@ -55,7 +56,7 @@ void Inspect(const InspectArgs& a) {
   const client::PartFileSet files =
       a.outputs.empty() ? cell.outputs : Take(client::ParsePartFileSet(a.outputs, "--outputs"));
   const std::unique_ptr<ResultsStore> store = a.db.empty() ? nullptr : OpenStore(a.db, false);
-  const auto part_ptr = std::make_shared<const TriangleMesh>(Take(ReadMesh(cell.part_mesh)));
+  const auto part_ptr = std::make_shared<const TriangleMesh>(Take(client::ReadCellPartMesh(cell)));
   const TriangleMesh& part = *part_ptr;
   InspectionSettings settings = client::InspectionSettingsOf(cell);
   if (a.tolerance != 0) settings.error_map.tolerance_mm = a.tolerance;
@@ -69,14 +70,17 @@ void Inspect(const InspectArgs& a) {
     settings.plan = Take(client::PlanOf(cell, part, settings.error_map));
   }
   std::vector<ViewScan> views;
+  std::vector<std::string> doubts;
   for (const auto& vp : cell.viewpoints) {
     const std::string path = a.scans + "/" + vp.name + ".pcd";
     if (!std::filesystem::exists(path)) continue;
     if (!vp.world_from_sensor)
       throw CommandFailed(a.cell + ": viewpoint " + vp.name +
                           " is not calibrated (run cell-agent calibrate)");
-    views.push_back({vp.name, Take(ReadPointCloud(path)), *vp.world_from_sensor});
+    views.push_back(
+        {vp.name, Take(client::ReadCellScan(cell, path, &part, &doubts)), *vp.world_from_sensor});
   }
+  for (const std::string& d : doubts) WarnUnitDoubt(d);
   if (views.empty()) throw CommandFailed(a.scans + ": no <viewpoint>.pcd scans for this cell");
   const std::string part_id = a.part_id.empty() ? FolderName(a.scans) : a.part_id;
   if (part_id.empty())
@@ -101,6 +105,7 @@ void Inspect(const InspectArgs& a) {
   outputs.mesh_in_part = part_ptr;
   outputs.viewpoints = client::ViewpointCalibrations(cell);
   if (cell.part_cad) outputs.cad = ReportCadOf(*cell.part_cad);
+  outputs.input_units = client::CellInputUnits(cell, doubts);
   Check(client::WritePartOutputs(a.out, outputs, files));
   std::printf("%s: %s  (min %.3f mm, max %.3f mm)  -> %s\n", part_id.c_str(),
               outputs.verdict.c_str(), outputs.min_mm, outputs.max_mm, a.out.c_str());

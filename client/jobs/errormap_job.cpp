@@ -20,6 +20,7 @@
 #include "core/io/io_mesh.h"
 #include "core/io/io_point_cloud.h"
 #include "core/io/io_transform.h"
+#include "core/io/unit_doubt.h"
 #include "core/plan/plan_evaluation.h"
 #include "core/report/error_map_png.h"
 #include "core/types/status_macros.h"
@@ -47,6 +48,7 @@ struct Inputs {
   bool keeps_cloud = false;  // the part frame's cloud would be a bit-identical copy
   double read_seconds = 0;
   std::optional<ReportCad> cad;  // a STEP/IGES mesh's tessellation
+  ReportInputUnits units;
 };
 
 // What either path computed: the per-point result, the report, the PNG.
@@ -66,7 +68,26 @@ void Log(const JobLog& log, const std::string& line) {
   if (log) log(line);
 }
 
-absl::StatusOr<Inputs> ReadInputs(const ErrorMapJob& job, const JobLog& log) {
+// The mesh in millimetres, the units recorded and doubted
+// (core/io/unit_doubt.h); the cloud was scaled as it was read.
+absl::Status MeshToMillimetres(const ErrorMapJob& job, Inputs& in, const JobLog& warn) {
+  if (in.cad && job.mesh_units.stated)
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--mesh-units: ", job.mesh, " is a STEP/IGES file, which declares its own unit (",
+        in.cad->declared_unit, ") and is read in millimetres whatever it is"));
+  ScaleToMillimetres(job.mesh_units.unit, &in.mesh);
+  const UnitSubject cloud{"cloud " + job.cloud, "--cloud-units", ExtentOf(in.cloud_in_world),
+                          job.cloud_units.stated};
+  const UnitSubject mesh{"mesh " + job.mesh, "--mesh-units", ExtentOf(in.mesh),
+                         job.mesh_units.stated || in.cad.has_value()};
+  in.units = ReportInputUnits{LengthUnitName(job.cloud_units.unit),
+                              in.cad ? "mm" : LengthUnitName(job.mesh_units.unit),
+                              job.cloud_units.stated, mesh.stated, UnitDoubts(cloud, &mesh)};
+  for (const std::string& doubt : in.units.doubts) Log(warn, doubt);
+  return absl::OkStatus();
+}
+
+absl::StatusOr<Inputs> ReadInputs(const ErrorMapJob& job, const JobLog& log, const JobLog& warn) {
   const auto t0 = Clock::now();
   Inputs in;
   // A STEP/IGES part is tessellated (or taken from the cache) first; its
@@ -88,6 +109,7 @@ absl::StatusOr<Inputs> ReadInputs(const ErrorMapJob& job, const JobLog& log) {
   tbb::parallel_invoke(
       [&] {
         cloud_read = ReadPointCloud(job.cloud);
+        if (cloud_read.ok()) ScaleToMillimetres(job.cloud_units.unit, &*cloud_read);
         if (!job.world_from_part.empty()) pose_read = ReadTransformJson(job.world_from_part);
         in.keeps_cloud = cloud_read.ok() && pose_read.ok() &&
                          TransformKeepsCloud(*cloud_read, pose_read->inverse());
@@ -99,11 +121,14 @@ absl::StatusOr<Inputs> ReadInputs(const ErrorMapJob& job, const JobLog& log) {
     ASSIGN_OR_RETURN(in.plan_json, ReadPlanJson(job.plan));
   }
   ASSIGN_OR_RETURN(in.mesh, std::move(mesh_read));
-  // A bad plan is refused before anything is computed.
+  RETURN_IF_ERROR(MeshToMillimetres(job, in, warn));
+  // A bad plan is refused before anything is computed. Its boxes are in
+  // millimetres; its groups are matched to the file in the file's unit.
   if (job.plan.empty()) {
     in.plan = PlanFromSettings(job.settings);
   } else {
-    ASSIGN_OR_RETURN(in.plan, ParsePlanForMeshFile(in.plan_json, in.mesh, mesh_path, job.settings));
+    ASSIGN_OR_RETURN(in.plan, ParsePlanForMeshFile(in.plan_json, in.mesh, mesh_path, job.settings,
+                                                   "plan", job.mesh_units.unit));
   }
   in.read_seconds = Seconds(t0);
   Log(log, absl::StrFormat("read %d points and %d triangles in %.3f s", in.cloud_in_world.size(),
@@ -299,10 +324,11 @@ absl::StatusOr<bool> Record(ResultsStore& store, const ErrorMapJob& job, const I
 }  // namespace
 
 absl::StatusOr<ErrorMapJobResult> RunErrorMapJob(const ErrorMapJob& job, RemoteClient* remote,
-                                                 ResultsStore* store, const JobLog& log) {
+                                                 ResultsStore* store, const JobLog& log,
+                                                 const JobLog& warn) {
   RETURN_IF_ERROR(ValidateErrorMapSettings(job.settings));
   const auto t0 = Clock::now();
-  ASSIGN_OR_RETURN(const Inputs in, ReadInputs(job, log));
+  ASSIGN_OR_RETURN(const Inputs in, ReadInputs(job, log, warn));
   // Reported only. In-process, the index build counts them; for the
   // server, they are counted here meanwhile.
   ReportMesh mesh_summary;
@@ -348,6 +374,7 @@ absl::StatusOr<ErrorMapJobResult> RunErrorMapJob(const ErrorMapJob& job, RemoteC
   timing.total_seconds = Seconds(t0);
   run.report.mesh = mesh_summary;
   run.report.cad = in.cad;
+  run.report.input_units = in.units;
   run.report.output_frame = job.frame;
   if (!job.report.empty()) {
     files.report_text = ReportText(run.report);

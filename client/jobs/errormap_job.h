@@ -16,6 +16,7 @@
 #include "core/cad/cad_settings.h"
 #include "core/errormap/error_map.h"
 #include "core/history/results_store.h"
+#include "core/io/length_units.h"
 #include "core/pipeline/inspection_report.h"
 
 namespace surfinspect::client {
@@ -35,6 +36,10 @@ struct ErrorMapJob {
   // and cached in cad_cache.
   CadSettings cad;
   std::string cad_cache;
+  // The units the cloud and the mesh files are in (core/io/length_units.h);
+  // assumed millimetres are checked for plausibility. Transforms and the
+  // plan are millimetres.
+  InputUnit cloud_units, mesh_units;
 };
 
 struct ErrorMapJobResult {
@@ -51,8 +56,10 @@ using JobLog = std::function<void(const std::string&)>;
 // The whole command. `remote` computes on that server (null: in-process);
 // `store` also records the part (null: no record). InvalidArgument for bad
 // settings or a bad plan, before anything is computed; a file's own error
-// otherwise. Runs on the calling thread's task arena.
+// otherwise. `warn` hears each unit doubt as soon as the files are read (the
+// report carries them too). Runs on the calling thread's task arena.
 absl::StatusOr<ErrorMapJobResult> RunErrorMapJob(const ErrorMapJob& job, RemoteClient* remote,
-                                                 ResultsStore* store, const JobLog& log = {});
+                                                 ResultsStore* store, const JobLog& log = {},
+                                                 const JobLog& warn = {});
 
 }  // namespace surfinspect::client

@@ -15,12 +15,14 @@ static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__,
 
 constexpr std::size_t kPclPage = 4096;
 
-std::string PcdHeader(const PointCloud& cloud, const char* data) {
-  return absl::StrCat(
-      "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\n"
-      "TYPE F F F\nCOUNT 1 1 1\nWIDTH ",
-      cloud.width, "\nHEIGHT ", cloud.height, "\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS ", cloud.size(),
-      "\nDATA ", data, "\n");
+// The unit as a comment line (PCL and our reader skip '#' lines), or none.
+std::string PcdHeader(const PointCloud& cloud, const char* data, std::string_view unit) {
+  return absl::StrCat("# .PCD v0.7 - Point Cloud Data file format\n",
+                      unit.empty() ? "" : absl::StrCat("# units: ", std::string(unit), "\n"),
+                      "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\n"
+                      "TYPE F F F\nCOUNT 1 1 1\nWIDTH ",
+                      cloud.width, "\nHEIGHT ", cloud.height, "\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS ",
+                      cloud.size(), "\nDATA ", data, "\n");
 }
 
 // One float as PCL's ascii writers print it: a stream of precision 9 (%.9g),
@@ -64,9 +66,13 @@ void AppendCompressed(const PointCloud& cloud, std::string& out) {
   out += packed;
 }
 
-std::string PlyBinaryHeader(std::size_t count) {
+std::string PlyUnitComment(std::string_view unit) {
+  return unit.empty() ? "" : absl::StrCat("comment units: ", std::string(unit), "\n");
+}
+
+std::string PlyBinaryHeader(std::size_t count, std::string_view unit) {
   return absl::StrCat(
-      "ply\nformat binary_little_endian 1.0\ncomment PCL generated\n"
+      "ply\nformat binary_little_endian 1.0\ncomment PCL generated\n", PlyUnitComment(unit),
       "obj_info is_cyberware_data 0\nobj_info is_mesh 0\nobj_info is_warped 0\n"
       "obj_info is_interlaced 0\nobj_info num_cols ",
       count,
@@ -81,16 +87,16 @@ std::string PlyBinaryHeader(std::size_t count) {
 
 }  // namespace
 
-std::string EncodePcd(const PointCloud& cloud, PcdEncoding encoding) {
+std::string EncodePcd(const PointCloud& cloud, PcdEncoding encoding, std::string_view unit) {
   switch (encoding) {
     case PcdEncoding::kAscii: {
-      std::string out = PcdHeader(cloud, "ascii");
+      std::string out = PcdHeader(cloud, "ascii", unit);
       out.reserve(out.size() + cloud.size() * 40);
       for (const Eigen::Vector3f& p : cloud.points) AppendAsciiPoint(p, out);
       return out;
     }
     case PcdEncoding::kBinary: {
-      std::string out = PcdHeader(cloud, "binary");
+      std::string out = PcdHeader(cloud, "binary", unit);
       const std::size_t padding = (out.size() + kPclPage - 1) / kPclPage * kPclPage - out.size();
       out.reserve(out.size() + cloud.size() * 12 + padding);
       AppendRaw(cloud, out);
@@ -98,7 +104,7 @@ std::string EncodePcd(const PointCloud& cloud, PcdEncoding encoding) {
       return out;
     }
     case PcdEncoding::kBinaryCompressed: {
-      std::string out = PcdHeader(cloud, "binary_compressed");
+      std::string out = PcdHeader(cloud, "binary_compressed", unit);
       AppendCompressed(cloud, out);
       return out;
     }
@@ -106,11 +112,12 @@ std::string EncodePcd(const PointCloud& cloud, PcdEncoding encoding) {
   return {};
 }
 
-std::string EncodePly(const PointCloud& cloud, bool binary) {
+std::string EncodePly(const PointCloud& cloud, bool binary, std::string_view unit) {
   const std::size_t valid = cloud.CountValid();
   std::string out =
-      binary ? PlyBinaryHeader(valid)
-             : absl::StrCat("ply\nformat ascii 1.0\ncomment surfinspect\nelement vertex ", valid,
+      binary ? PlyBinaryHeader(valid, unit)
+             : absl::StrCat("ply\nformat ascii 1.0\ncomment surfinspect\n", PlyUnitComment(unit),
+                            "element vertex ", valid,
                             "\nproperty float x\nproperty float y\nproperty float z\nend_header\n");
   out.reserve(out.size() + valid * (binary ? 12 : 40));
   cloud.ForEachValid([&](std::size_t, const Eigen::Vector3f& p) {

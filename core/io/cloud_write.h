@@ -17,6 +17,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 
 #include "core/types/point_cloud.h"
 
@@ -27,7 +28,10 @@ enum class PcdEncoding { kAscii, kBinary, kBinaryCompressed };
 // The whole file. `cloud` must pass Validate(); for binary_compressed its
 // planes and their LZF stream must fit the format's uint32 sizes
 // (WritePointCloud refuses clouds of more than 2^32 / 24 points).
-std::string EncodePcd(const PointCloud& cloud, PcdEncoding encoding);
-std::string EncodePly(const PointCloud& cloud, bool binary);
+// A non-empty `unit` adds one comment line naming the coordinates' unit
+// ("# units: mm" after the PCD's first line, "comment units: mm" after the
+// PLY's first comment); without it the bytes are PCL's.
+std::string EncodePcd(const PointCloud& cloud, PcdEncoding encoding, std::string_view unit = "");
+std::string EncodePly(const PointCloud& cloud, bool binary, std::string_view unit = "");
 
 }  // namespace surfinspect

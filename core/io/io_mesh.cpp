@@ -96,10 +96,10 @@ absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path, const MeshReadLim
 }
 
 absl::StatusOr<MeshGroups> ReadMeshGroups(const std::string& path, const TriangleMesh& mesh,
-                                          const MeshReadLimits& limits) {
+                                          const MeshReadLimits& limits, LengthUnit file_unit) {
   if (Extension(path) != "obj") return MeshGroups{};
   ASSIGN_OR_RETURN(auto bytes, ReadWholeFile(path, limits.max_file_bytes));
-  return ObjGroups(bytes, mesh, path);
+  return ObjGroups(bytes, mesh, path, file_unit);
 }
 
 bool PlyDeclaresFaces(const std::string& path) {

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "absl/status/statusor.h"
+#include "core/io/length_units.h"
 #include "core/io/read_limits.h"
 #include "core/types/mesh_groups.h"
 #include "core/types/triangle_mesh.h"
@@ -23,9 +24,11 @@ absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path, const MeshReadLim
 
 // The named groups of the file ReadMesh read as `mesh`: an OBJ's `g` / `o`
 // groups (obj_groups.h); empty for other formats and files without groups.
+// `mesh` may have been scaled to millimetres from the file's `file_unit`.
 // FailedPrecondition when the groups cannot be mapped onto the triangles.
 absl::StatusOr<MeshGroups> ReadMeshGroups(const std::string& path, const TriangleMesh& mesh,
-                                          const MeshReadLimits& limits = {});
+                                          const MeshReadLimits& limits = {},
+                                          LengthUnit file_unit = LengthUnit::kMillimetre);
 
 // True when the file's PLY header parses and declares a face element with
 // rows: such a PLY is a mesh, any other a point cloud.

@@ -36,7 +36,7 @@ absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path, const CloudRe
 }
 
 absl::Status WritePointCloud(const std::string& path, const PointCloud& cloud,
-                             PcdEncoding pcd_encoding, bool ply_binary) {
+                             PcdEncoding pcd_encoding, bool ply_binary, std::string_view unit) {
   RETURN_IF_ERROR(cloud.Validate());
   const std::string ext = Extension(path);
   if (ext != "pcd" && ext != "ply")
@@ -50,7 +50,8 @@ absl::Status WritePointCloud(const std::string& path, const PointCloud& cloud,
         path, ": ", cloud.size(), " points are more than a binary_compressed PCD can hold"));
   std::string bytes;
   try {
-    bytes = ext == "pcd" ? EncodePcd(cloud, pcd_encoding) : EncodePly(cloud, ply_binary);
+    bytes =
+        ext == "pcd" ? EncodePcd(cloud, pcd_encoding, unit) : EncodePly(cloud, ply_binary, unit);
   } catch (const std::bad_alloc&) {
     return absl::ResourceExhaustedError(
         absl::StrCat(path, ": cannot allocate the file's ", cloud.size(), " points"));

@@ -22,9 +22,11 @@ absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path,
                                           const CloudReadLimits& limits = {});
 
 // PCD keeps the grid; PLY stores only the valid points (PLY has no grid).
+// The header names the coordinates' unit (millimetres unless a command
+// writes its input's unit back, as filter --out-units does).
 // Written atomically (temporary file, then rename).
 absl::Status WritePointCloud(const std::string& path, const PointCloud& cloud,
                              PcdEncoding pcd_encoding = PcdEncoding::kBinary,
-                             bool ply_binary = true);
+                             bool ply_binary = true, std::string_view unit = "mm");
 
 }  // namespace surfinspect

@@ -10,15 +10,18 @@
 #include <string_view>
 
 #include "absl/status/statusor.h"
+#include "core/io/length_units.h"
 #include "core/types/mesh_groups.h"
 #include "core/types/triangle_mesh.h"
 
 namespace surfinspect {
 
 // `bytes` passed CheckObj (mesh_precheck.h); `imported` is ReadMesh's mesh of
-// the same bytes. Empty groups when the file names none.
+// the same bytes, possibly scaled to millimetres from `file_unit`
+// (length_units.h). Empty groups when the file names none.
 absl::StatusOr<MeshGroups> ObjGroups(std::string_view bytes, const TriangleMesh& imported,
-                                     std::string_view name = "<obj>");
+                                     std::string_view name = "<obj>",
+                                     LengthUnit file_unit = LengthUnit::kMillimetre);
 
 // The OBJ text of `mesh` with its groups: a `g` line before each run of
 // triangles in the same groups, vertices with 9 significant digits (every

@@ -166,6 +166,15 @@ void VisitCad(V& v, R& c) {
   v("tolerance_held", c.tolerance_held);
 }
 
+template <typename V, typename R>
+void VisitInputUnits(V& v, R& u) {
+  v("cloud", u.cloud);
+  v("cloud_stated", u.cloud_stated);
+  v("mesh", u.mesh);
+  v("mesh_stated", u.mesh_stated);
+  v("doubts", u.doubts);
+}
+
 // A Visit function as the argument Object and List take.
 #define SURFINSPECT_VISIT(F) [](auto& v, auto& part) { F(v, part); }
 
@@ -195,6 +204,7 @@ void VisitReport(V& v, R& r) {
   v.Object("inputs", r.inputs, SURFINSPECT_VISIT(VisitInputs));
   v.Object("mesh", r.mesh, SURFINSPECT_VISIT(VisitMesh));
   v.Object("cad", r.cad, SURFINSPECT_VISIT(VisitCad));
+  v.Object("input_units", r.input_units, SURFINSPECT_VISIT(VisitInputUnits));
   if (V::kReads || !r.output_frame.empty()) v("output_frame", r.output_frame);
 }
 

@@ -105,6 +105,16 @@ struct ReportCad {
 };
 ReportCad ReportCadOf(const CadReport& report);
 
+// The units the inputs were read in (everything after is millimetres), and
+// whether the user stated them; `doubts` holds what the plausibility rule
+// said of units that were assumed (core/io/unit_doubt.h): a result with a
+// doubt may be 1000 times off.
+struct ReportInputUnits {
+  std::string cloud = "mm", mesh = "mm";
+  bool cloud_stated = false, mesh_stated = false;
+  std::vector<std::string> doubts;
+};
+
 struct InspectionReport {
   std::string schema;   // kReportSchema with a plan; "" for an error-map report alone
   std::string verdict;  // the part verdict; "" without a plan
@@ -120,8 +130,9 @@ struct InspectionReport {
   // Written by the CLI's errormap only.
   std::optional<ReportInputs> inputs;
   std::optional<ReportMesh> mesh;
-  std::optional<ReportCad> cad;  // set by the client that tessellated the part
-  std::string output_frame;      // "" when not said
+  std::optional<ReportCad> cad;                 // set by the client that tessellated the part
+  std::optional<ReportInputUnits> input_units;  // set by the client that read the files
+  std::string output_frame;                     // "" when not said
   bool pass() const { return verdict == "pass"; }
 };
 

@@ -29,12 +29,10 @@ absl::StatusOr<InspectionPlan> ParsePlanWithDefaults(const nlohmann::json& json,
   return plan;
 }
 
-absl::StatusOr<InspectionPlan> ParsePlanForMeshFile(const nlohmann::json& json,
-                                                    const TriangleMesh& part,
-                                                    const std::string& mesh_path,
-                                                    const ErrorMapSettings& settings,
-                                                    const std::string& where) {
-  const absl::StatusOr<MeshGroups> groups = ReadMeshGroups(mesh_path, part);
+absl::StatusOr<InspectionPlan> ParsePlanForMeshFile(
+    const nlohmann::json& json, const TriangleMesh& part, const std::string& mesh_path,
+    const ErrorMapSettings& settings, const std::string& where, LengthUnit file_unit) {
+  const absl::StatusOr<MeshGroups> groups = ReadMeshGroups(mesh_path, part, {}, file_unit);
   auto plan =
       ParsePlanWithDefaults(json, part, settings, where, groups.ok() ? *groups : MeshGroups{});
   if (plan.ok() || groups.ok()) return plan;

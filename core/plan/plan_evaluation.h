@@ -17,6 +17,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/errormap/error_map.h"
+#include "core/io/length_units.h"
 #include "core/plan/characteristics.h"
 #include "core/plan/defects.h"
 #include "core/plan/inspection_plan.h"
@@ -41,13 +42,15 @@ absl::StatusOr<InspectionPlan> ParsePlanWithDefaults(const nlohmann::json& json,
                                                      const MeshGroups& groups = {});
 
 // ParsePlanWithDefaults with the groups of the CAD file `mesh_path` that
-// `part` was read from (io_mesh.h ReadMeshGroups). A file whose groups cannot
+// `part` was read from (io_mesh.h ReadMeshGroups), in millimetres scaled from
+// the file's `file_unit`. A file whose groups cannot
 // be read has none; a plan that selects one is then refused with that reason.
 absl::StatusOr<InspectionPlan> ParsePlanForMeshFile(const nlohmann::json& json,
                                                     const TriangleMesh& part,
                                                     const std::string& mesh_path,
                                                     const ErrorMapSettings& settings,
-                                                    const std::string& where = "plan");
+                                                    const std::string& where = "plan",
+                                                    LengthUnit file_unit = LengthUnit::kMillimetre);
 
 struct PlanOutcome {
   CharacteristicsResult characteristics;  // surface, regions, points

@@ -125,7 +125,8 @@ absl::Status WriteErrorMapPly(const std::string& path, const PointCloud& points,
     BufferedFile out(tmp);
     out.Append(absl::StrCat(
         "ply\nformat binary_little_endian 1.0\n",
-        "comment surfinspect error map: deviation in mm, + above the CAD surface, nan unmatched\n",
+        "comment surfinspect error map: deviation in mm, + above the CAD surface, nan unmatched\n"
+        "comment units: mm\n",
         "comment frame: ", frame_name, "\nelement vertex ", points.CountValid(),
         "\nproperty float x\nproperty float y\nproperty float z\n"
         "property float scalar_deviation\nproperty float quality\n"

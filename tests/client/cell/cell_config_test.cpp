@@ -43,6 +43,51 @@ TEST(CellConfig, ReadsTheSettingsBlocks) {
   EXPECT_EQ(c->filter_settings.connectivity, 4);
 }
 
+// "units" for the scans and the part, sensor.units and part.units for each;
+// absent = millimetres assumed (and doubted where implausible); a STEP part
+// declares its own; a bad unit is named with its field.
+TEST(CellConfig, UnitsAreStatedForBothOrEachAndAssumedOtherwise) {
+  auto none = Read(Cell(""));
+  ASSERT_TRUE(none.ok()) << none.status();
+  EXPECT_FALSE(none->sensor_units.stated);
+  EXPECT_FALSE(none->part_units.stated);
+  auto both = Read(Cell(R"(, "units": "in")"));
+  ASSERT_TRUE(both.ok()) << both.status();
+  EXPECT_EQ(both->sensor_units.unit, LengthUnit::kInch);
+  EXPECT_EQ(both->part_units.unit, LengthUnit::kInch);
+  EXPECT_TRUE(both->part_units.stated);
+  auto each = Read(Cell(R"(, "units": "mm", "sensor": {"units": "m"})"));
+  ASSERT_TRUE(each.ok()) << each.status();
+  EXPECT_EQ(each->sensor_units.unit, LengthUnit::kMetre);
+  EXPECT_EQ(each->part_units.unit, LengthUnit::kMillimetre);
+  EXPECT_TRUE(each->part_units.stated);
+  const auto bad = Read(Cell(R"(, "sensor": {"units": "metres"})"));
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("sensor.units: unknown length unit \"metres\""),
+            std::string::npos)
+      << bad.status();
+  const auto number = Read(Cell(R"(, "units": 1000)"));
+  EXPECT_NE(number.status().message().find("units: must be a string"), std::string::npos)
+      << number.status();
+}
+
+TEST(CellConfig, AStepPartDeclaresItsOwnUnit) {
+  const std::string step = std::string(R"({"part": {"mesh": "p.stp", "world_from_part": )") +
+                           kIdentity + R"(}, "viewpoints": [{"name": "v1"}], "units": "m")";
+  auto c = Read(step + "}");
+  ASSERT_TRUE(c.ok()) << c.status();
+  EXPECT_EQ(c->sensor_units.unit, LengthUnit::kMetre);
+  EXPECT_EQ(c->part_units.unit, LengthUnit::kMillimetre);  // OpenCASCADE converts
+  EXPECT_TRUE(c->part_units.stated);
+  std::string with_units = step;
+  with_units.replace(with_units.find("\"p.stp\""), 7, R"("p.stp", "units": "in")");
+  const auto refused = Read(with_units + "}");
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.status().message().find("part.units: a STEP/IGES part declares its own unit"),
+            std::string::npos)
+      << refused.status();
+}
+
 // "outputs" names the files each part gets, by catalogue name; an unknown
 // name is refused by name before any part is taken.
 TEST(CellConfig, OutputsAreCatalogueNamesAndTheDefaultLeavesOutTheCsv) {

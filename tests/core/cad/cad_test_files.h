@@ -1,24 +1,15 @@
-// The real STEP files of ../shared/realdata/cad beside the checkout, and the
-// built worker. Tests that need a real file skip loudly without it.
+// The real STEP files of ../shared/realdata/cad beside the checkout. Tests
+// that need a real file skip loudly without it.
 #pragma once
 
-#include <filesystem>
 #include <string>
+
+#include "tests/support/real_data.h"
 
 namespace surfinspect::testing {
 
-inline std::string RealCad(const std::string& name) {
-  return (std::filesystem::path(SURFINSPECT_SOURCE_DIR) / ".." / "shared" / "realdata" / "cad" /
-          name)
-      .lexically_normal()
-      .string();
-}
+inline std::string RealCad(const std::string& name) { return RealData("cad/" + name); }
 
-inline bool HaveRealCad() { return std::filesystem::exists(RealCad("cube-mm.step")); }
-
-#define SKIP_WITHOUT_REAL_CAD()                                                            \
-  if (!::surfinspect::testing::HaveRealCad())                                              \
-  GTEST_SKIP() << "../shared/realdata/cad not found beside the checkout: REAL STEP FILES " \
-                  "NOT CHECKED"
+#define SKIP_WITHOUT_REAL_CAD() SKIP_WITHOUT_REAL_DATA("cad/cube-mm.step")
 
 }  // namespace surfinspect::testing

@@ -8,6 +8,8 @@
 #include <sstream>
 
 #include "core/io/lzf.h"
+#include "core/io/pcd_format.h"
+#include "core/io/ply_cloud.h"
 
 namespace surfinspect {
 namespace {
@@ -80,6 +82,30 @@ TEST(CloudWrite, AsciiNaNIsWrittenAsPclWritesItWhateverItsSign) {
   EXPECT_NE(file.find("DATA ascii\nnan nan nan\n-0 1.40129846e-45 123456792\nnan nan nan\n"),
             std::string::npos)
       << file;
+}
+
+// The unit comment is one line more than PCL's bytes, in each encoding, and
+// our readers (as PCL's) read the same points through it.
+TEST(CloudWrite, TheUnitCommentIsOneLineMoreThanPclsBytesAndReadsTheSame) {
+  const PointCloud grid = GoldenGrid();
+  std::string gold = Golden("pcl113_grid_ascii.pcd");
+  gold.insert(gold.find('\n') + 1, "# units: mm\n");
+  EXPECT_EQ(EncodePcd(grid, PcdEncoding::kAscii, "mm"), gold);
+  const std::string ply = Golden("pcl113_grid_valid_binary.ply");
+  const std::string marker = "comment PCL generated\n";
+  std::string ply_gold = ply;
+  ply_gold.insert(ply.find(marker) + marker.size(), "comment units: m\n");
+  EXPECT_EQ(EncodePly(grid, true, "m"), ply_gold);
+  for (PcdEncoding e :
+       {PcdEncoding::kAscii, PcdEncoding::kBinary, PcdEncoding::kBinaryCompressed}) {
+    const absl::StatusOr<PointCloud> back = ParsePcd(EncodePcd(grid, e, "in"));
+    ASSERT_TRUE(back.ok()) << back.status();
+    ASSERT_EQ(back->size(), grid.size());
+    EXPECT_EQ(0, std::memcmp(back->points.data(), grid.points.data(), grid.size() * 12));
+  }
+  const absl::StatusOr<PointCloud> ascii_ply = ParsePlyCloud(EncodePly(grid, false, "mm"));
+  ASSERT_TRUE(ascii_ply.ok()) << ascii_ply.status();
+  EXPECT_EQ(ascii_ply->size(), grid.CountValid());
 }
 
 }  // namespace

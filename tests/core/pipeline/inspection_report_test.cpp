@@ -287,6 +287,10 @@ TEST(InspectionReport, RoundTripKeepsTheStructAndTheBytes) {
       report.mesh = ReportMesh{100, 4, 0, 1};
       report.output_frame = "part";
     }
+    if (seed % 4 == 0) {  // a STEP part, a cloud in metres, a doubt on the mesh
+      report.cad = ReportCad{"p.stp", "STEP", "INCH", 0.01, 0.0064, true};
+      report.input_units = ReportInputUnits{"m", "mm", true, false, {"mesh b.stl: small"}};
+    }
     const std::string text = ReportText(report);
     const absl::StatusOr<InspectionReport> back = ParseReport(text);
     ASSERT_TRUE(back.ok()) << back.status();
@@ -300,6 +304,14 @@ TEST(InspectionReport, RoundTripKeepsTheStructAndTheBytes) {
     EXPECT_EQ(back->timing.total_seconds, report.timing.total_seconds);
     EXPECT_EQ(back->inputs.has_value(), report.inputs.has_value());
     EXPECT_EQ(back->output_frame, report.output_frame);
+    ASSERT_EQ(back->input_units.has_value(), report.input_units.has_value());
+    if (report.input_units) {
+      EXPECT_EQ(back->input_units->cloud, "m");
+      EXPECT_TRUE(back->input_units->cloud_stated);
+      EXPECT_FALSE(back->input_units->mesh_stated);
+      EXPECT_EQ(back->input_units->doubts, report.input_units->doubts);
+      EXPECT_EQ(back->cad->tessellation_error_mm, 0.0064);
+    }
     const bool same_p99 = back->stats.p99_mm == report.stats.p99_mm ||
                           (std::isnan(back->stats.p99_mm) && std::isnan(report.stats.p99_mm));
     EXPECT_TRUE(same_p99);
