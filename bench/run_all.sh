@@ -34,7 +34,7 @@ if [ "${BENCH_SKIP_GBENCH:-0}" != 1 ]; then
 fi
 # Stand-alone benches with goals of their own; each prints its table, kept
 # as RESULTS_DIR/NAME.txt.
-for b in inspection_plan_bench; do
+for b in inspection_plan_bench cad_bench; do
   [ -x "$BIN_DIR/$b" ] || die "$BIN_DIR/$b not built"
   log "$b"
   tmp=$(mktemp "$RESULTS_DIR/.$b.XXXXXX")

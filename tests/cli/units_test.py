@@ -20,7 +20,6 @@ usage: units_test.py BIN_DIR [unittest args]
 import json
 import math
 import os
-import shutil
 import struct
 import subprocess
 import sys
@@ -29,6 +28,9 @@ import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "client", "agent"))
 import agent_soak_test as soak  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import cad_part_test as cad  # noqa: E402
 
 BIN = None
 REAL = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)),
@@ -293,12 +295,7 @@ class AgentUnitsTests(unittest.TestCase):
         port = soak.free_port()
         server = soak.start_server(port, os.path.join(root, "server.log"))
         try:
-            r = subprocess.run(
-                [os.path.join(BIN, "cell-agent"), "run", "--cell", cell_json,
-                 "--server", f"127.0.0.1:{port}", "--inbox", os.path.join(root, "inbox"),
-                 "--results", os.path.join(root, "results"),
-                 "--quarantine", os.path.join(root, "quarantine"), "--once", "--timeout", "60"],
-                capture_output=True, text=True, timeout=300)
+            r = cad.run_agent(cell_json, root, port)
         finally:
             soak.stop(server)
         return root, r
@@ -334,7 +331,7 @@ class AgentUnitsTests(unittest.TestCase):
 def main():
     global BIN
     BIN = sys.argv.pop(1)
-    soak.BIN = BIN
+    soak.BIN = cad.BIN = BIN
     unittest.main(verbosity=2)
 
 

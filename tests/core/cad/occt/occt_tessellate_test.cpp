@@ -14,12 +14,16 @@
 #include <BRepTopAdaptor_FClass2d.hxx>
 #include <BRep_Tool.hxx>
 #include <Bnd_Box.hxx>
+#include <IGESControl_Controller.hxx>
+#include <IGESControl_Writer.hxx>
 #include <Poly_Triangulation.hxx>
+#include <STEPControl_Reader.hxx>
 #include <algorithm>
 
 #include "core/cad/occt/occt_model.h"
 #include "core/distance/mesh_index.h"
 #include "tests/core/cad/cad_test_files.h"
+#include "tests/support/temp_dir.h"
 
 namespace surfinspect::occt {
 namespace {
@@ -153,6 +157,33 @@ TEST(Tessellation, ABodyIsChosenByNameWithItsColour) {
   s.body = "sphere";
   EXPECT_EQ(TessellateCad(RealCad("red_cube_blue_cylinder.step"), s).status().code(),
             absl::StatusCode::kInvalidArgument);
+}
+
+// IGES as OpenCASCADE's own writer saves a real STEP part (B-rep mode, in
+// inches): the same faces, the same box in millimetres, the error held.
+TEST(Tessellation, AnIgesOfTheSamePartGivesTheSameFacesAndBox) {
+  SKIP_WITHOUT_REAL_CAD();
+  const std::string name = "bug3883_xr2-ct-214_l-bracket.stp";
+  STEPControl_Reader reader;
+  ASSERT_EQ(reader.ReadFile(RealCad(name).c_str()), IFSelect_RetDone);
+  reader.TransferRoots();
+  IGESControl_Controller::Init();
+  IGESControl_Writer writer("IN", 1);
+  ASSERT_TRUE(writer.AddShape(reader.OneShape()));
+  writer.ComputeModel();
+  const testing::TempDir dir;
+  const std::string iges = dir.File("bracket.igs");
+  ASSERT_TRUE(writer.Write(iges.c_str()));
+  const CadTessellation step = Tessellate(name);
+  const absl::StatusOr<CadTessellation> from_iges = TessellateCad(iges, TessellationSettings{});
+  ASSERT_TRUE(from_iges.ok()) << from_iges.status();
+  EXPECT_EQ(from_iges->report.format, "IGES");
+  EXPECT_EQ(from_iges->report.declared_unit, "INCH");
+  EXPECT_EQ(from_iges->report.faces, step.report.faces);
+  EXPECT_TRUE(from_iges->report.tolerance_held) << from_iges->report.tessellation_error_mm;
+  const Bounds3 a = ComputeBounds(step.mesh), b = ComputeBounds(from_iges->mesh);
+  EXPECT_LT((a.min - b.min).norm(), 1e-4);
+  EXPECT_LT((a.max - b.max).norm(), 1e-4);
 }
 
 TEST(Tessellation, ATighterToleranceIsMetByRefining) {
