@@ -94,10 +94,15 @@ struct Sampler {
     return bound;
   }
 
-  double Error(const MeshedFace& m, uint32_t t, double u, double v, const Eigen::Vector3d& p) {
+  // The sample's error; `worst` is the face's largest so far. A tightened
+  // value is never above `direct`, so where `direct` cannot raise the
+  // largest, tightening is skipped: the face's error is the same, bit for
+  // bit, and most samples of a curved face need no extrema.
+  double Error(const MeshedFace& m, uint32_t t, double u, double v, const Eigen::Vector3d& p,
+               double worst) {
     const Eigen::Vector3d s = Vec(surface.Value(u, v));
     const double direct = (s - p).norm();
-    if (direct <= loose_mm) return direct;
+    if (direct <= std::max(loose_mm, worst)) return direct;
     if (!ring) ring.emplace(m);
     return std::max(ring->Distance(s, t), ToSurface(gp_Pnt(p.x(), p.y(), p.z()), u, v, direct));
   }
@@ -122,7 +127,7 @@ double InteriorError(const TopoDS_Face& face, const BRepAdaptor_Surface& surface
         const double u = w[0] * uv[0].X() + w[1] * uv[1].X() + w[2] * uv[2].X();
         const double v = w[0] * uv[0].Y() + w[1] * uv[1].Y() + w[2] * uv[2].Y();
         const Eigen::Vector3d p = w[0] * corner[0] + w[1] * corner[1] + w[2] * corner[2];
-        worst = std::max(worst, sampler.Error(m, static_cast<uint32_t>(t - 1), u, v, p));
+        worst = std::max(worst, sampler.Error(m, static_cast<uint32_t>(t - 1), u, v, p, worst));
       }
   }
   return worst;
