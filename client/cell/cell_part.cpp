@@ -1,5 +1,8 @@
 #include "client/cell/cell_part.h"
 
+#include <algorithm>
+#include <optional>
+
 #include "absl/strings/str_format.h"
 #include "core/cad/cad_import.h"
 #include "core/io/io_mesh.h"

@@ -315,6 +315,21 @@ std::vector<ReportField> SettingsFields(const InspectionReport& r) {
     VisitInputs(inputs, *r.inputs);
     add(inputs.out);
   }
+  // What the numbers rest on: the CAD's measured tessellation error and the
+  // units the files were read in, with any doubt, by their report.json keys.
+  auto add_prefixed = [&](const char* prefix, const json& group) {
+    for (const auto& [key, value] : group.items()) out.push_back({prefix + key, value});
+  };
+  if (r.cad) {
+    JsonWriter cad;
+    VisitCad(cad, *r.cad);
+    add_prefixed("cad.", cad.out);
+  }
+  if (r.input_units) {
+    JsonWriter units;
+    VisitInputUnits(units, *r.input_units);
+    add_prefixed("input_units.", units.out);
+  }
   return out;
 }
 

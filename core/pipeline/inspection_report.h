@@ -158,7 +158,8 @@ std::vector<ReportField> PointCountFields(const InspectionReport& report);  // c
 std::vector<ReportField> StatisticsFields(const InspectionReport& report);  // min_mm .. p99_mm
 // within, above, below, fraction_within of the +-band verdict.
 std::vector<ReportField> ToleranceCountFields(const InspectionReport& report);
-// The settings, then the inputs when there are some, each group by key.
+// The settings, then the inputs, the CAD ("cad.*") and the input units
+// ("input_units.*") when there are some, each group by key.
 std::vector<ReportField> SettingsFields(const InspectionReport& report);
 
 // The sections alone, as report.json holds them.

@@ -383,6 +383,24 @@ TEST(InspectionReport, FieldListsCarryTheReportsKeysAndValues) {
     EXPECT_EQ(f.value, j["tolerance"][f.key]) << f.key;
   EXPECT_EQ(ToleranceCountFields(report).size(), 4u);
   for (const ReportField& f : SettingsFields(report)) EXPECT_EQ(f.value, j["settings"][f.key]);
+  // The CAD and the units follow, under their report.json keys.
+  InspectionReport with = report;
+  with.cad = ReportCad{"p.stp", "STEP", "INCH", 0.01, 0.0064, true};
+  with.input_units = ReportInputUnits{"m", "mm", true, false, {"a doubt"}};
+  const nlohmann::json w = EncodeReport(with);
+  std::size_t cad = 0, units = 0;
+  for (const ReportField& f : SettingsFields(with)) {
+    if (f.key.rfind("cad.", 0) == 0) {
+      EXPECT_EQ(f.value, w["cad"][f.key.substr(4)]) << f.key;
+      ++cad;
+    }
+    if (f.key.rfind("input_units.", 0) == 0) {
+      EXPECT_EQ(f.value, w["input_units"][f.key.substr(12)]) << f.key;
+      ++units;
+    }
+  }
+  EXPECT_EQ(cad, 6u);
+  EXPECT_EQ(units, 5u);
 }
 
 }  // namespace
