@@ -9,6 +9,7 @@
 // child process (client/cad/cad_worker.cpp), never in a server or agent.
 #pragma once
 
+#include <TopoDS_Shape.hxx>
 #include <string>
 
 #include "absl/status/statusor.h"
@@ -26,6 +27,10 @@ struct CadTessellation {
   MeshGroups groups;
   CadReport report;
 };
+
+// One meshing of `shape` as every pass does it: BRepMesh_IncrementalMesh at
+// `deflection_mm` and `angle_deg`, faces in parallel, Delabella's Delaunay.
+void MeshShape(const TopoDS_Shape& shape, double deflection_mm, double angle_deg);
 
 // The report's `passes` says how many meshings it took; tolerance_held is
 // false (with the measured error) when kMaxPasses did not reach it.

@@ -6,10 +6,12 @@
 #include <stdlib.h>
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 
+#include "core/distance/mesh_index.h"
 #include "tests/core/cad/cad_test_files.h"
 #include "tests/support/temp_dir.h"
 
@@ -41,12 +43,36 @@ TEST_F(CadImport, InchAndMillimetreCubesGiveTheSameMesh) {
   ASSERT_TRUE(mm.ok()) << mm.status();
   EXPECT_EQ(inch->report.declared_unit, "INCH");
   EXPECT_EQ(mm->report.declared_unit, "MILLIMETRE");
-  ASSERT_EQ(inch->mesh.vertices.size(), mm->mesh.vertices.size());
-  ASSERT_EQ(inch->mesh.triangles, mm->mesh.triangles);
-  for (std::size_t i = 0; i < mm->mesh.vertices.size(); ++i)
+  ASSERT_EQ(inch->mesh.num_triangles(), mm->mesh.num_triangles());
+  // The same nodes, in whatever order the triangles first use them.
+  const auto sorted = [](std::vector<Eigen::Vector3f> v) {
+    std::sort(v.begin(), v.end(), [](const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
+      return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+    });
+    return v;
+  };
+  const std::vector<Eigen::Vector3f> a = sorted(inch->mesh.vertices), b = sorted(mm->mesh.vertices);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i)
     for (int k = 0; k < 3; ++k)
-      EXPECT_NEAR(inch->mesh.vertices[i][k], mm->mesh.vertices[i][k],
-                  1e-9 * std::max(1.0f, std::abs(mm->mesh.vertices[i][k])));
+      EXPECT_NEAR(a[i][k], b[i][k], 1e-9 * std::max(1.0f, std::abs(b[i][k])));
+  // The same surface: Delaunay may take either diagonal of a square face
+  // (four nodes on one circle), so each mesh's triangles are checked to lie
+  // on the other, at their corners and centroids, to 1e-9 of the size.
+  for (const auto* pair : {&*inch, &*mm}) {
+    const TriangleMesh& a = pair->mesh;
+    const TriangleMesh& b = pair == &*inch ? mm->mesh : inch->mesh;
+    const auto index = MeshIndex::Build(b);
+    ASSERT_TRUE(index.ok()) << index.status();
+    for (const auto& t : a.triangles) {
+      Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+      for (uint32_t v : t) {
+        EXPECT_LE((*index)->Closest(a.vertices[v].cast<double>()).distance_mm, 1e-9 * 1000);
+        centroid += a.vertices[v].cast<double>() / 3;
+      }
+      EXPECT_LE((*index)->Closest(centroid).distance_mm, 1e-9 * 1000);
+    }
+  }
   EXPECT_NEAR(mm->report.bounds_mm.max.x() - mm->report.bounds_mm.min.x(), 1000, 1e-6);
 }
 

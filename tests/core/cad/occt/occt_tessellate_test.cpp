@@ -106,8 +106,7 @@ TEST(Tessellation, AFaceGroupHoldsExactlyThatFacesTriangles) {
   // The face's own triangulation, meshed the same way and read from OCCT.
   auto model = ReadOcctModel(RealCad("bug3883_xr2-ct-214_l-bracket.stp"), "");
   ASSERT_TRUE(model.ok());
-  BRepMesh_IncrementalMesh(model->shape, t.report.deflection_mm, false,
-                           t.report.angular_tolerance_deg * M_PI / 180, true);
+  MeshShape(model->shape, t.report.deflection_mm, t.report.angular_tolerance_deg);
   for (std::size_t f = 0; f < model->faces.size(); ++f) {
     const uint32_t g = static_cast<uint32_t>(
         std::find(t.groups.names.begin(), t.groups.names.end(), "face:" + std::to_string(f + 1)) -
