@@ -36,6 +36,9 @@ PointCloud CloudToWrite(const FilterArgs& a, const PointCloud& as_read,
   if (a.out_units == "mm") return Take(wire::CloudFromProto(resp.cloud(), "cloud", wire::Limits{}));
   PointCloud out = as_read;
   const std::string& kept = resp.kept_mask();
+  if (kept.size() != out.size())
+    throw CommandFailed("the filter's kept mask has " + std::to_string(kept.size()) +
+                        " entries for " + std::to_string(out.size()) + " points");
   for (std::size_t i = 0; i < out.size(); ++i)
     if (!kept[i]) out.points[i] = Eigen::Vector3f::Constant(NAN);
   return out;

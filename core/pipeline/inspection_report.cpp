@@ -304,32 +304,18 @@ std::vector<ReportField> ToleranceCountFields(const InspectionReport& r) {
 
 std::vector<ReportField> SettingsFields(const InspectionReport& r) {
   std::vector<ReportField> out;
-  auto add = [&](const json& group) {
-    for (const auto& [key, value] : group.items()) out.push_back({key, value});
+  // Each group's fields, keys after `prefix`: the settings and inputs bare,
+  // then what the numbers rest on (the CAD's measured tessellation error,
+  // the units read, with any doubt) under their report.json keys.
+  auto add = [&](const std::string& prefix, const auto& part, auto visit) {
+    JsonWriter w;
+    visit(w, part);
+    for (const auto& [key, value] : w.out.items()) out.push_back({prefix + key, value});
   };
-  JsonWriter settings;
-  VisitSettings(settings, r.settings);
-  add(settings.out);
-  if (r.inputs) {
-    JsonWriter inputs;
-    VisitInputs(inputs, *r.inputs);
-    add(inputs.out);
-  }
-  // What the numbers rest on: the CAD's measured tessellation error and the
-  // units the files were read in, with any doubt, by their report.json keys.
-  auto add_prefixed = [&](const char* prefix, const json& group) {
-    for (const auto& [key, value] : group.items()) out.push_back({prefix + key, value});
-  };
-  if (r.cad) {
-    JsonWriter cad;
-    VisitCad(cad, *r.cad);
-    add_prefixed("cad.", cad.out);
-  }
-  if (r.input_units) {
-    JsonWriter units;
-    VisitInputUnits(units, *r.input_units);
-    add_prefixed("input_units.", units.out);
-  }
+  add("", r.settings, SURFINSPECT_VISIT(VisitSettings));
+  if (r.inputs) add("", *r.inputs, SURFINSPECT_VISIT(VisitInputs));
+  if (r.cad) add("cad.", *r.cad, SURFINSPECT_VISIT(VisitCad));
+  if (r.input_units) add("input_units.", *r.input_units, SURFINSPECT_VISIT(VisitInputUnits));
   return out;
 }
 
