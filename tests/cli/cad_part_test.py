@@ -169,8 +169,9 @@ class CadCommandTests(unittest.TestCase):
         self.assertIn("cached tessellation reused", again.stderr)
 
 
-def step_cell(root, part, plan=None, cad=None):
-    """The demo cell at SENSOR_PX with the true poses, its part a STEP file."""
+def truth_cell(root, edit):
+    """The demo cell in root/cell at SENSOR_PX, calibrated with the true poses
+    and changed by edit(cell dict); returns its cell.json."""
     cell = os.path.join(root, "cell")
     subprocess.run([os.path.join(BIN, "surfinspect"), "demo-cell", "--out", cell, "--parts", "0"],
                    check=True, stdout=subprocess.DEVNULL)
@@ -178,15 +179,24 @@ def step_cell(root, part, plan=None, cad=None):
     c = load_json(cell_json)
     for vp in c["viewpoints"]:
         vp["world_from_sensor"] = vp["simulation_truth_world_from_sensor"]
+    edit(c)
+    write_json(cell_json, c)
+    soak.shrink_sensor(cell_json, *soak.SENSOR_PX)
+    return cell_json
+
+
+def step_cell(root, part, plan=None, cad=None):
+    """The truth cell with a STEP file as its part."""
+    return truth_cell(root, lambda c: with_step_part(c, os.path.join(root, "cell"), part, plan, cad))
+
+
+def with_step_part(c, cell, part, plan, cad):
     c["part"] = {"mesh": part, "world_from_part": NIST_POSE}
     c.pop("plan")
     if plan:
         c["plan"] = write_json(os.path.join(cell, "step-plan.json"), plan)
     if cad:
         c["cad"] = cad
-    write_json(cell_json, c)
-    soak.shrink_sensor(cell_json, *soak.SENSOR_PX)
-    return cell_json
 
 
 def run_agent(cell_json, root, port, env=None):

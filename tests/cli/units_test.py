@@ -265,17 +265,7 @@ class AgentUnitsTests(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.root = tempfile.mkdtemp(prefix="units-agent-")
-        cell = os.path.join(cls.root, "cell")
-        subprocess.run([os.path.join(BIN, "surfinspect"), "demo-cell", "--out", cell, "--parts", "0"],
-                       check=True, stdout=subprocess.DEVNULL)
-        cls.cell_json = os.path.join(cell, "cell.json")
-        c = load(cls.cell_json)
-        for vp in c["viewpoints"]:
-            vp["world_from_sensor"] = vp["simulation_truth_world_from_sensor"]
-        c.pop("units")  # a cell that does not say
-        with open(cls.cell_json, "w") as f:
-            json.dump(c, f, indent=1)
-        soak.shrink_sensor(cls.cell_json, *soak.SENSOR_PX)
+        cls.cell_json = cad.truth_cell(cls.root, lambda c: c.pop("units"))  # a cell that does not say
         cls.parts = soak.stage_parts(cls.root, cls.cell_json, 2, seed=21)
 
     def run_cell(self, name, sensor_units, metres):
