@@ -59,7 +59,8 @@ void RunErrorMap(ErrorMapArgs& a) {
   // Bad parameters are refused before any file is read.
   Check(ValidateErrorMapSettings(job.settings));
   job.cloud_units = a.units.Cloud();
-  job.mesh_units = a.units.Mesh();
+  // A STEP/IGES part declares its own unit: --units is the cloud's alone.
+  job.mesh_units = IsCadPath(job.mesh) && a.units.mesh_units.empty() ? InputUnit{} : a.units.Mesh();
   const std::unique_ptr<ResultsStore> store = a.db.empty() ? nullptr : OpenStore(a.db, false);
   const std::unique_ptr<client::RemoteClient> remote =
       a.remote.remote() ? Connect(a.remote) : nullptr;

@@ -163,10 +163,17 @@ class CadCommandTests(unittest.TestCase):
         self.assertEqual(chars["top"]["verdict"], "pass")
         # A face the sensor cannot see (its normal across the view) has few points.
         self.assertLess(chars["side"]["points"], chars["top"]["points"])
+        # --units is the cloud's alone with a STEP part; --mesh-units is refused.
         again = cli("errormap", "--cloud", self.path("scan.pcd"), "--mesh", BRACKET,
                     "--cad-cache", self.path("cache"), "--world-from-part", self.path("pose.json"),
-                    "--out", self.path("em2.ply"))
+                    "--units", "mm", "--out", self.path("em2.ply"), "--report", self.path("em2.json"))
         self.assertIn("cached tessellation reused", again.stderr)
+        self.assertEqual(load_json(self.path("em2.json"))["input_units"]["cloud_stated"], True)
+        refused = cli("errormap", "--cloud", self.path("scan.pcd"), "--mesh", BRACKET,
+                      "--cad-cache", self.path("cache"), "--mesh-units", "in",
+                      "--out", self.path("em3.ply"), check=False)
+        self.assertEqual(refused.returncode, 1)
+        self.assertIn("declares its own unit", refused.stderr)
 
 
 def truth_cell(root, edit):
