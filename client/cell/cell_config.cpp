@@ -116,12 +116,12 @@ absl::Status ReadSettings(const nlohmann::json& j, CellConfig& c) {
 absl::StatusOr<InputUnit> UnitAt(const nlohmann::json& o, const std::string& where,
                                  const InputUnit& fallback) {
   if (!o.is_object() || !o.contains("units")) return fallback;
-  const absl::StatusOr<InputUnit> u = o["units"].is_string()
-                                          ? InputUnitOf(o["units"].get<std::string>())
-                                          : absl::InvalidArgumentError("must be a string");
-  if (!u.ok() || !u->stated)
-    return absl::InvalidArgumentError(absl::StrCat(
-        where, ": ", u.ok() ? "must not be empty" : u.status().message(), " (mm, cm, m or in)"));
+  if (!o["units"].is_string())
+    return absl::InvalidArgumentError(where + ": must be a string (mm, cm, m or in)");
+  const absl::StatusOr<InputUnit> u = InputUnitOf(o["units"].get<std::string>());
+  if (!u.ok()) return absl::InvalidArgumentError(absl::StrCat(where, ": ", u.status().message()));
+  if (!u->stated)
+    return absl::InvalidArgumentError(where + ": must not be empty (mm, cm, m or in)");
   return *u;
 }
 
