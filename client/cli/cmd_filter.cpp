@@ -29,6 +29,11 @@ struct FilterArgs {
   std::string out_units = "mm";  // or "input"
 };
 
+// The unit the output is written in: millimetres, or the input's.
+const char* OutputUnitName(const FilterArgs& a, const InputUnit& unit) {
+  return a.out_units == "mm" ? "mm" : LengthUnitName(unit.unit);
+}
+
 // The cloud to write: the filtered one in millimetres, or the input as read
 // with the removed points NaN, so kept points keep their bits in either unit.
 PointCloud CloudToWrite(const FilterArgs& a, const PointCloud& as_read,
@@ -114,7 +119,7 @@ void WriteFilterReport(const FilterArgs& a, const PointCloud& cloud, const v1::F
                       {"units",
                        {{"input", LengthUnitName(unit.unit)},
                         {"input_stated", unit.stated},
-                        {"output", a.out_units == "mm" ? "mm" : LengthUnitName(unit.unit)},
+                        {"output", OutputUnitName(a, unit)},
                         {"doubts", doubts}}}};
   Check(WriteStringAtomically(a.report, j.dump(2) + "\n"));
 }
@@ -137,7 +142,7 @@ void Filter(const FilterArgs& a) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const v1::FilterStats& stats = resp.stats();
   Check(WritePointCloud(a.out, CloudToWrite(a, as_read, resp), PcdEncoding::kBinary, true,
-                        a.out_units == "mm" ? "mm" : LengthUnitName(unit.unit)));
+                        OutputUnitName(a, unit)));
   spdlog::info("{}: {} valid points, kept {}, removed {} in {} clusters ({:.2f} ms)", a.in,
                stats.valid_points(), stats.kept(), stats.removed(), stats.clusters(),
                seconds * 1e3);

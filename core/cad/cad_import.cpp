@@ -56,6 +56,13 @@ absl::Status RunWorker(const std::string& path, const CadSettings& s, const std:
                     absl::StrCat("tessellating ", path));
 }
 
+// The settings checked and the file's SHA-256, read within the size limit.
+absl::StatusOr<std::string> CheckedSha256(const std::string& path, const CadSettings& settings) {
+  RETURN_IF_ERROR(ValidateCadSettings(settings));
+  ASSIGN_OR_RETURN(const std::string bytes, ReadFileToString(path, settings.limits.max_file_bytes));
+  return Sha256Hex(bytes);
+}
+
 }  // namespace
 
 absl::StatusOr<std::string> CadWorkerPath() {
@@ -75,11 +82,10 @@ absl::StatusOr<std::string> CadWorkerPath() {
 absl::StatusOr<CadReport> TessellateCadFile(const std::string& path, const CadSettings& settings,
                                             const std::string& obj_path,
                                             const std::string& report_path) {
-  RETURN_IF_ERROR(ValidateCadSettings(settings));
-  ASSIGN_OR_RETURN(const std::string bytes, ReadFileToString(path, settings.limits.max_file_bytes));
+  ASSIGN_OR_RETURN(const std::string sha, CheckedSha256(path, settings));
   RETURN_IF_ERROR(RunWorker(path, settings, obj_path, report_path));
   ASSIGN_OR_RETURN(CadReport report, ReadReport(report_path));
-  report.source_sha256 = Sha256Hex(bytes);
+  report.source_sha256 = sha;
   return report;
 }
 
@@ -101,9 +107,7 @@ std::string CadCacheKey(const std::string& file_sha256, const TessellationSettin
 
 absl::StatusOr<CadMesh> ImportCad(const std::string& path, const CadSettings& settings,
                                   const std::string& cache_dir) {
-  RETURN_IF_ERROR(ValidateCadSettings(settings));
-  ASSIGN_OR_RETURN(const std::string bytes, ReadFileToString(path, settings.limits.max_file_bytes));
-  const std::string sha = Sha256Hex(bytes);
+  ASSIGN_OR_RETURN(const std::string sha, CheckedSha256(path, settings));
   const std::string key = CadCacheKey(sha, settings.tessellation);
   const std::string obj = (fs::path(cache_dir) / (key + ".obj")).string();
   const std::string json = (fs::path(cache_dir) / (key + ".json")).string();

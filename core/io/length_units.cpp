@@ -23,13 +23,6 @@ const UnitRow& RowOf(LengthUnit unit) {
   return kUnits[0];
 }
 
-template <typename Points>
-void Scale(LengthUnit unit, Points* points) {
-  if (unit == LengthUnit::kMillimetre) return;
-  const double k = MillimetresPer(unit);
-  for (Eigen::Vector3f& p : *points) p = (p.cast<double>() * k).cast<float>();
-}
-
 }  // namespace
 
 absl::StatusOr<LengthUnit> ParseLengthUnit(std::string_view name) {
@@ -49,7 +42,16 @@ absl::StatusOr<InputUnit> InputUnitOf(std::string_view name) {
   return InputUnit{*unit, true};
 }
 
-void ScaleToMillimetres(LengthUnit unit, PointCloud* cloud) { Scale(unit, &cloud->points); }
-void ScaleToMillimetres(LengthUnit unit, TriangleMesh* mesh) { Scale(unit, &mesh->vertices); }
+void ScaleToMillimetres(LengthUnit unit, std::vector<Eigen::Vector3f>* points) {
+  if (unit == LengthUnit::kMillimetre) return;
+  const double k = MillimetresPer(unit);
+  for (Eigen::Vector3f& p : *points) p = (p.cast<double>() * k).cast<float>();
+}
+void ScaleToMillimetres(LengthUnit unit, PointCloud* cloud) {
+  ScaleToMillimetres(unit, &cloud->points);
+}
+void ScaleToMillimetres(LengthUnit unit, TriangleMesh* mesh) {
+  ScaleToMillimetres(unit, &mesh->vertices);
+}
 
 }  // namespace surfinspect

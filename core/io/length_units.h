@@ -7,6 +7,7 @@
 
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "core/types/point_cloud.h"
@@ -31,6 +32,7 @@ absl::StatusOr<InputUnit> InputUnitOf(std::string_view name);
 
 // Coordinates times MillimetresPer(unit), each rounded once to float; a
 // millimetre input is left as it is (bit for bit), NaN stays NaN.
+void ScaleToMillimetres(LengthUnit unit, std::vector<Eigen::Vector3f>* points);
 void ScaleToMillimetres(LengthUnit unit, PointCloud* cloud);
 void ScaleToMillimetres(LengthUnit unit, TriangleMesh* mesh);
 

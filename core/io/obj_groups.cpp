@@ -109,14 +109,11 @@ bool CornersOf(const TriangleMesh& mesh, std::size_t t, const ObjFaces& file, co
 absl::StatusOr<MeshGroups> ObjGroups(std::string_view bytes, const TriangleMesh& imported,
                                      std::string_view name, LengthUnit file_unit) {
   ASSIGN_OR_RETURN(auto file, ReadFaces(bytes, name));
-  // Compared with the imported mesh as it was scaled (SamePosition's
-  // tolerance covers the two roundings).
-  TriangleMesh scaled;
-  scaled.vertices = std::move(file.vertices);
-  ScaleToMillimetres(file_unit, &scaled);
-  file.vertices = std::move(scaled.vertices);
   MeshGroups groups;
   if (file.groups.names.empty()) return groups;
+  // Compared with the imported mesh as it was scaled (SamePosition's
+  // tolerance covers the two roundings).
+  ScaleToMillimetres(file_unit, &file.vertices);
   groups.names = file.groups.names;
   groups.triangle_group.reserve(imported.num_triangles());
   std::size_t t = 0;

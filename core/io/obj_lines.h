@@ -13,8 +13,7 @@
 
 namespace surfinspect {
 
-// Calls visit(tokens, line number) for every OBJ line with a token; stops at
-// the first error visit returns.
+// The line up to a '#' that begins a token.
 inline std::string_view WithoutObjComment(std::string_view line) {
   for (std::size_t i = 0; i < line.size(); ++i)
     if (line[i] == '#' && (i == 0 || line[i - 1] == ' ' || line[i - 1] == '\t'))
@@ -22,6 +21,8 @@ inline std::string_view WithoutObjComment(std::string_view line) {
   return line;
 }
 
+// Calls visit(tokens, line number) for every OBJ line with a token; stops at
+// the first error visit returns.
 template <typename Visit>
 absl::Status ForEachObjLine(std::string_view bytes, Visit&& visit) {
   LineScanner lines(bytes);

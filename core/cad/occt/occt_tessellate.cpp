@@ -142,10 +142,10 @@ void MeshShape(const TopoDS_Shape& shape, double deflection_mm, double angle_deg
   mesh.Deflection = deflection_mm;
   mesh.Angle = angle_deg * M_PI / 180;
   mesh.InParallel = true;
-  // Delabella's sweep instead of the default Watson insertion, whose circle
-  // search took 69% of the CPU on a plate with 384 holes: 2.8 s instead of
-  // 6.5 s there (bench/cad_bench.cpp). Same nodes; where four or more lie on
-  // one circle (a square) it may pick the other diagonal.
+  // Delabella's sweep instead of the default Watson insertion: Watson's
+  // circle search dominates on faces with many holes, the case
+  // bench/cad_bench.cpp measures against OCCT's defaults. Same nodes; where
+  // four or more lie on one circle (a square) it may pick the other diagonal.
   mesh.MeshAlgo = IMeshTools_MeshAlgoType_Delabella;
   BRepMesh_IncrementalMesh(shape, mesh);
 }
