@@ -117,6 +117,9 @@ void DefectToProto(const Defect& d, v1::DefectResult* msg) {
   msg->set_area_mm2(d.area_mm2);
   msg->set_extent_mm(d.extent_mm);
   msg->set_peak_mm(d.peak_mm);
+  msg->set_peak_fitted(d.peak_fitted);
+  msg->set_measured_extreme_mm(d.measured_extreme_mm);
+  msg->set_noise_mm(d.noise_mm);
   msg->set_points(d.points);
   msg->set_region(d.region);
 }
@@ -173,6 +176,9 @@ DefectsResult DefectsFromProto(const google::protobuf::RepeatedPtrField<v1::Defe
     d.area_mm2 = m.area_mm2();
     d.extent_mm = m.extent_mm();
     d.peak_mm = m.peak_mm();
+    d.peak_fitted = m.peak_fitted();
+    d.measured_extreme_mm = m.measured_extreme_mm();
+    d.noise_mm = m.noise_mm();
     d.points = m.points();
     d.region = m.region();
     out.defects.push_back(std::move(d));

@@ -48,6 +48,9 @@ void VisitDefect(V& v, R& d) {
   v("area_mm2", d.area_mm2);
   v("extent_mm", d.extent_mm);
   v("peak_mm", d.peak_mm);
+  v("peak_source", d.peak_source);
+  v("measured_extreme_mm", d.measured_extreme_mm);
+  v("noise_mm", d.noise_mm);
   v("points", d.points);
   v("region", d.region);
 }
@@ -254,6 +257,9 @@ ReportDefect ReportDefectOf(const Defect& d) {
   out.area_mm2 = d.area_mm2;
   out.extent_mm = d.extent_mm;
   out.peak_mm = d.peak_mm;
+  out.peak_source = d.peak_fitted ? "fit" : "median";
+  out.measured_extreme_mm = d.measured_extreme_mm;
+  out.noise_mm = d.noise_mm;
   out.points = d.points;
   out.region = d.region;
   return out;

@@ -71,6 +71,11 @@ struct ReportDefect {
   std::string kind;  // "dent" | "bump"
   Eigen::Vector3d centroid_mm = Eigen::Vector3d::Zero();
   double area_mm2 = 0, extent_mm = 0, peak_mm = 0;
+  // "fit" (the Gaussian's c + A) or "median" (the deepest local median: the
+  // fit failed or left the measured extremes), with the evidence the fit was
+  // checked against (core/plan/defects.h). "" in a report from before them.
+  std::string peak_source;
+  double measured_extreme_mm = NAN, noise_mm = NAN;
   std::size_t points = 0;
   std::string region;  // "" outside every region
   bool operator==(const ReportDefect& o) const;

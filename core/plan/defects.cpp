@@ -85,8 +85,12 @@ std::vector<std::vector<uint32_t>> Patches(const std::vector<int8_t>& sign,
 }
 
 // Points within `reach` of the seed, grown from the patch through links.
+// Points of an opposite-sign patch (a bump beside a dent) are left out: they
+// belong to another defect's profile, and a single Gaussian fitted across
+// both is pulled towards the neighbour.
 std::vector<uint32_t> FitSupport(const ErrorMapResult& em, const SurfaceNeighbourhood& nb,
-                                 const std::vector<uint32_t>& patch, uint32_t seed, double reach) {
+                                 const std::vector<uint32_t>& patch, uint32_t seed, double reach,
+                                 const std::vector<int8_t>& sign) {
   constexpr std::size_t kMaxPoints = 200000;  // bounds the work on a huge patch
   std::unordered_map<uint32_t, char> seen;
   std::vector<uint32_t> out(patch.begin(), patch.end()), near;
@@ -94,10 +98,29 @@ std::vector<uint32_t> FitSupport(const ErrorMapResult& em, const SurfaceNeighbou
   for (std::size_t k = 0; k < out.size() && out.size() < kMaxPoints; ++k) {
     nb.Links(out[k], near);
     for (uint32_t j : near)
-      if (seen.emplace(j, 1).second && Distance(em, seed, j) <= reach) out.push_back(j);
+      if (seen.emplace(j, 1).second && sign[j] != -sign[seed] && Distance(em, seed, j) <= reach)
+        out.push_back(j);
   }
   std::sort(out.begin(), out.end());
   return out;
+}
+
+// What the patch measured: its raw deviations' extremes and the noise about
+// its local medians (1.4826 MAD, a robust sigma).
+struct PatchEvidence {
+  double min_mm = INFINITY, max_mm = -INFINITY, noise_mm = 0;
+};
+PatchEvidence MeasuredExtremes(const ErrorMapResult& em, const std::vector<float>& median,
+                               const std::vector<uint32_t>& patch) {
+  PatchEvidence e;
+  std::vector<double> residual;
+  for (uint32_t i : patch) {
+    e.min_mm = std::min<double>(e.min_mm, em.deviation_mm[i]);
+    e.max_mm = std::max<double>(e.max_mm, em.deviation_mm[i]);
+    residual.push_back(std::abs(em.deviation_mm[i] - median[i]));
+  }
+  e.noise_mm = 1.4826 * MedianInPlace(residual);
+  return e;
 }
 
 }  // namespace
@@ -106,16 +129,59 @@ const char* DefectKindName(DefectKind kind) { return kind == DefectKind::kDent ?
 
 namespace {
 
-// The robust Gaussian fit of one patch's peak into `d` (peak_mm, fit fields).
+// The defect placed at `centre` (the fitted Gaussian's, on the seed's
+// tangent plane), moved onto the plane of the CAD triangle under the support
+// point nearest to it.
+void PlaceAtFittedCentre(const ErrorMapResult& em, const std::vector<Eigen::Vector3f>& normals,
+                         const std::vector<uint32_t>& support, const Eigen::Vector3d& centre,
+                         Defect& d) {
+  uint32_t nearest = support[0];
+  double best = INFINITY;
+  for (uint32_t j : support) {
+    const double d2 = (em.closest_point[j].cast<double>() - centre).squaredNorm();
+    if (d2 < best) best = d2, nearest = j;
+  }
+  d.triangle_id = em.triangle_id[nearest];
+  const Eigen::Vector3d n = normals[d.triangle_id].cast<double>().normalized();
+  d.centroid_mm = centre - (centre - em.closest_point[nearest].cast<double>()).dot(n) * n;
+}
+
+// The Gaussian fitted to `uvd`, then refitted once without the samples
+// beyond 5 robust sigma of its residuals (stray pixels).
+GaussianFit RobustGaussianFit(const std::vector<Eigen::Vector3d>& uvd, const GaussianFit& start) {
+  std::vector<char> keep(uvd.size(), 1);
+  GaussianFit fit = FitIsotropicGaussian(uvd, keep, start);
+  if (!fit.ok) return fit;
+  const double s2 = fit.sigma * fit.sigma;
+  std::vector<double> abs_res(uvd.size());
+  for (std::size_t k = 0; k < uvd.size(); ++k) {
+    const double r2 = (uvd[k].head<2>() - fit.centre).squaredNorm();
+    abs_res[k] = std::abs(fit.baseline + fit.amplitude * std::exp(-r2 / (2 * s2)) - uvd[k].z());
+  }
+  std::vector<double> copy = abs_res;
+  const double cut = 5 * 1.4826 * MedianInPlace(copy);
+  for (std::size_t k = 0; k < uvd.size(); ++k) keep[k] = abs_res[k] <= cut;
+  return FitIsotropicGaussian(uvd, keep, fit);
+}
+
+// One patch's peak into `d`: the robust Gaussian fit over the patch and a
+// ring around it, kept only when it is plausible: a centre within reach, a
+// width between a quarter spacing and the reach, the patch's sign, and a
+// peak within the patch's measured extremes widened by 3 sigma of the noise
+// (a fit can diverge to a huge narrow spike between samples, e.g. beside
+// fixture points at a boundary). Otherwise the peak is the deepest local
+// median, a measured value. A kept fit also places the defect: its centre
+// is not biased where an edge or a view's border cuts the patch, as the
+// patch's centroid is.
 void FitPeak(const ErrorMapResult& em, const SurfaceNeighbourhood& nb,
-             const std::vector<float>& median, const std::vector<uint32_t>& patch,
-             const Eigen::Vector3f& seed_normal, uint32_t seed, double threshold_mm,
-             double spacing_mm, Defect& d) {
+             const std::vector<float>& median, const std::vector<int8_t>& sign,
+             const std::vector<uint32_t>& patch, const std::vector<Eigen::Vector3f>& normals,
+             uint32_t seed, double threshold_mm, double spacing_mm, Defect& d) {
   double radius = 0;
   for (uint32_t i : patch) radius = std::max<double>(radius, Distance(em, seed, i));
   const double reach = std::min(2 * radius + 3 * spacing_mm, 30.0);
-  const std::vector<uint32_t> support = FitSupport(em, nb, patch, seed, reach);
-  const Eigen::Vector3d n = seed_normal.cast<double>().normalized();
+  const std::vector<uint32_t> support = FitSupport(em, nb, patch, seed, reach, sign);
+  const Eigen::Vector3d n = normals[em.triangle_id[seed]].cast<double>().normalized();
   const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
   const Eigen::Vector3d o = em.closest_point[seed].cast<double>();
   std::vector<Eigen::Vector3d> uvd;
@@ -129,27 +195,19 @@ void FitPeak(const ErrorMapResult& em, const SurfaceNeighbourhood& nb,
   start.sigma = std::max(
       spacing_mm,
       r_eq / std::sqrt(2 * std::log(std::max(std::abs(start.amplitude) / threshold_mm, 1.5))));
-  std::vector<char> keep(uvd.size(), 1);
-  GaussianFit fit = FitIsotropicGaussian(uvd, keep, start);
-  if (fit.ok) {  // drop points beyond 5 robust sigma (stray pixels) and refit once
-    const double s2 = fit.sigma * fit.sigma;
-    std::vector<double> abs_res(uvd.size());
-    for (std::size_t k = 0; k < uvd.size(); ++k) {
-      const double r2 = (uvd[k].head<2>() - fit.centre).squaredNorm();
-      abs_res[k] = std::abs(fit.baseline + fit.amplitude * std::exp(-r2 / (2 * s2)) - uvd[k].z());
-    }
-    std::vector<double> copy = abs_res;
-    const double cut = 5 * 1.4826 * MedianInPlace(copy);
-    for (std::size_t k = 0; k < uvd.size(); ++k) keep[k] = abs_res[k] <= cut;
-    fit = FitIsotropicGaussian(uvd, keep, fit);
-  }
+  const GaussianFit fit = RobustGaussianFit(uvd, start);
+  const PatchEvidence e = MeasuredExtremes(em, median, patch);
+  d.measured_extreme_mm = median[seed] < 0 ? e.min_mm : e.max_mm;
+  d.noise_mm = e.noise_mm;
   const double peak = fit.baseline + fit.amplitude;
-  const bool plausible = fit.ok && fit.centre.norm() <= reach && fit.sigma > 0.25 * spacing_mm &&
-                         fit.sigma < reach && (peak < 0) == (median[seed] < 0);
-  d.peak_fitted = plausible;
-  d.peak_mm = plausible ? peak : median[seed];
-  d.fit_sigma_mm = plausible ? fit.sigma : NAN;
-  d.fit_rms_mm = plausible ? fit.rms : NAN;
+  d.peak_fitted = fit.ok && fit.centre.norm() <= reach && fit.sigma > 0.25 * spacing_mm &&
+                  fit.sigma < reach && (peak < 0) == (median[seed] < 0) &&
+                  peak >= e.min_mm - 3 * e.noise_mm && peak <= e.max_mm + 3 * e.noise_mm;
+  d.peak_mm = d.peak_fitted ? peak : median[seed];
+  d.fit_sigma_mm = d.peak_fitted ? fit.sigma : NAN;
+  d.fit_rms_mm = d.peak_fitted ? fit.rms : NAN;
+  if (d.peak_fitted)
+    PlaceAtFittedCentre(em, normals, support, o + fit.centre.x() * u + fit.centre.y() * v, d);
 }
 
 // Area, centroid on the surface and extent of one patch into `d`.
@@ -252,8 +310,7 @@ absl::StatusOr<DefectsResult> FindDefects(const ErrorMapResult& em, const PointC
     for (uint32_t i : patch)
       if (std::abs(median[i]) > std::abs(median[seed])) seed = i;
     d.kind = median[seed] < 0 ? DefectKind::kDent : DefectKind::kBump;
-    FitPeak(em, *nb, median, patch, normals[em.triangle_id[seed]], seed, rules.threshold_mm,
-            out.spacing_mm, d);
+    FitPeak(em, *nb, median, sign, patch, normals, seed, rules.threshold_mm, out.spacing_mm, d);
     if (plan) {
       const int region = plan->FirstRegionOf(d.triangle_id);
       if (region >= 0) d.region = plan->plan.regions[static_cast<std::size_t>(region)].name;

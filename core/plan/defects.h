@@ -30,7 +30,10 @@
 //     (core/plan/gaussian_fit.h) to the raw deviations of the
 //     component and a ring around it (points beyond 5 robust sigma dropped
 //     and the fit repeated once); peak = c + A, the deviation at the fitted
-//     centre. Should the fit fail, the peak is the deepest median.
+//     centre. The fit is kept only when plausible (its peak within the
+//     patch's measured extremes +- 3 sigma of the noise, among others);
+//     otherwise the peak is the deepest median. A kept fit's centre is the
+//     defect's position: a patch cut by an edge has a biased centroid.
 //
 // Units mm, part frame. Deterministic: the same result for any thread count.
 #pragma once
@@ -55,12 +58,19 @@ const char* DefectKindName(DefectKind kind);  // "dent" | "bump"
 struct Defect {
   int id = 0;  // 1.. in order of decreasing |peak_mm|
   DefectKind kind = DefectKind::kDent;
-  Eigen::Vector3d centroid_mm = Eigen::Vector3d::Zero();  // area-weighted, on the CAD surface
-  uint32_t triangle_id = UINT32_MAX;                      // the CAD triangle under the centroid
+  // On the CAD surface: the fitted Gaussian's centre when the peak is
+  // fitted, else the patch's area-weighted centroid.
+  Eigen::Vector3d centroid_mm = Eigen::Vector3d::Zero();
+  uint32_t triangle_id = UINT32_MAX;  // the CAD triangle under the centroid
   double area_mm2 = 0;
-  double extent_mm = 0;       // length along the patch's principal axis
-  double peak_mm = 0;         // signed: < 0 for a dent
-  bool peak_fitted = false;   // false: the peak is the deepest median
+  double extent_mm = 0;      // length along the patch's principal axis
+  double peak_mm = 0;        // signed: < 0 for a dent
+  bool peak_fitted = false;  // false: the peak is the deepest median
+  // Evidence for the peak: the patch's most extreme raw deviation on the
+  // defect's side, and the noise about the local medians (robust sigma).
+  // A fitted peak lies within the patch's extremes +- 3 noise_mm.
+  double measured_extreme_mm = NAN;
+  double noise_mm = NAN;
   double fit_sigma_mm = NAN;  // the fitted Gaussian's s (lateral size)
   double fit_rms_mm = NAN;    // RMS residual of the fit
   std::size_t points = 0;     // scanned points in the patch

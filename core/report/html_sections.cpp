@@ -98,12 +98,14 @@ std::string CharacteristicsTable(const InspectionReport& report) {
 std::string DefectsTable(const InspectionReport& report) {
   if (report.defects.empty()) return "<p id=\"defects\" class=\"none\">no defects found</p>\n";
   std::string out =
-      "<table id=\"defects\"><thead><tr><th>id</th><th>kind</th><th>peak mm</th><th>area mm\u00b2"
+      "<table id=\"defects\"><thead><tr><th>id</th><th>kind</th><th>peak mm</th><th>peak "
+      "from</th><th>area mm\u00b2"
       "</th><th>extent mm</th><th>points</th><th>region</th></tr></thead><tbody>\n";
   for (const ReportDefect& d : report.defects) {
     absl::StrAppend(&out, "<tr class=\"defect\" tabindex=\"0\" data-defect=\"", d.id, "\">",
-                    Td(d.id), Td(d.kind), Td(JsonNumber(d.peak_mm)), Td(JsonNumber(d.area_mm2)),
-                    Td(JsonNumber(d.extent_mm)), Td(d.points), Td(d.region), "</tr>\n");
+                    Td(d.id), Td(d.kind), Td(JsonNumber(d.peak_mm)), Td(d.peak_source),
+                    Td(JsonNumber(d.area_mm2)), Td(JsonNumber(d.extent_mm)), Td(d.points),
+                    Td(d.region), "</tr>\n");
   }
   return out + "</tbody></table>\n";
 }

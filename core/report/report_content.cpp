@@ -64,14 +64,14 @@ void AddCharacteristics(const std::vector<ReportCharacteristic>& list, ReportCon
 
 void AddDefects(const std::vector<ReportDefect>& list, ReportContent& c) {
   ReportTable& t = c.defects;
-  t.header = {"defect",   "kind",      "region", "peak mm",
+  t.header = {"defect",   "kind",      "region", "peak mm",           "peak from",
               "area mm2", "extent mm", "points", "centroid mm (part)"};
   for (const ReportDefect& d : list) {
     Defect mark;
     mark.id = d.id;
     mark.centroid_mm = d.centroid_mm;
     c.defect_marks.push_back(mark);
-    t.rows.push_back({absl::StrCat(d.id), d.kind, d.region, FormatMm(d.peak_mm),
+    t.rows.push_back({absl::StrCat(d.id), d.kind, d.region, FormatMm(d.peak_mm), d.peak_source,
                       absl::StrFormat("%.1f", d.area_mm2), absl::StrFormat("%.1f", d.extent_mm),
                       Count(d.points),
                       absl::StrFormat("%.1f, %.1f, %.1f", d.centroid_mm.x(), d.centroid_mm.y(),

@@ -128,6 +128,9 @@ void ExpectTypedEqualsJson(const Msg& m) {
     EXPECT_EQ(d.id(), dj["id"]);
     EXPECT_EQ(d.kind() == v1::DEFECT_DENT ? "dent" : "bump", dj["kind"]);
     EXPECT_EQ(d.peak_mm(), dj["peak_mm"]);
+    EXPECT_EQ(d.peak_fitted() ? "fit" : "median", dj["peak_source"]);
+    ExpectSame(d.measured_extreme_mm(), dj["measured_extreme_mm"], "measured extreme");
+    ExpectSame(d.noise_mm(), dj["noise_mm"], "noise");
     EXPECT_EQ(d.area_mm2(), dj["area_mm2"]);
     EXPECT_EQ(d.points(), dj["points"]);
     EXPECT_EQ(d.region(), dj["region"]);

@@ -9,7 +9,7 @@ namespace {
 
 TEST(PartRecord, FromReport) {
   const std::string defects =
-      R"([{"area_mm2":12.5,"centroid_mm":[1.5,-2.0,60.0],"extent_mm":4.0,"id":1,"kind":"dent","peak_mm":-0.25,"points":180,"region":"ridge"}])";
+      R"([{"area_mm2":12.5,"centroid_mm":[1.5,-2.0,60.0],"extent_mm":4.0,"id":1,"kind":"dent","measured_extreme_mm":-0.27,"noise_mm":0.015,"peak_mm":-0.25,"peak_source":"fit","points":180,"region":"ridge"}])";
   const std::string report = R"({"verdict": "fail", "defects": )" + defects + R"(,
     "characteristics": [
       {"name": "surface", "type": "surface", "verdict": "pass", "mean_mm": 0.01, "min_mm": -0.2,

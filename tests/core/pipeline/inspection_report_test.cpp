@@ -71,19 +71,26 @@ TEST(InspectionReport, DefectsCarryTheSchemaFields) {
   d.area_mm2 = 12.5;
   d.extent_mm = 4;
   d.peak_mm = 0.25;
+  d.peak_fitted = true;
+  d.measured_extreme_mm = 0.27;
+  d.noise_mm = 0.015;
   d.points = 180;
   d.region = "ridge";
   r.defects = {d};
   const nlohmann::json j = DefectsJson(r);
   ASSERT_EQ(j.size(), 1u);
   EXPECT_EQ(Keys(j[0]), (std::set<std::string>{"id", "kind", "centroid_mm", "area_mm2", "extent_mm",
-                                               "peak_mm", "points", "region"}));
+                                               "peak_mm", "peak_source", "measured_extreme_mm",
+                                               "noise_mm", "points", "region"}));
   EXPECT_EQ(j[0]["id"], 1);
   EXPECT_EQ(j[0]["kind"], "bump");
   EXPECT_EQ(j[0]["centroid_mm"], (nlohmann::json{1.5, -2.0, 60.0}));
   EXPECT_EQ(j[0]["area_mm2"], 12.5);
   EXPECT_EQ(j[0]["extent_mm"], 4.0);
   EXPECT_EQ(j[0]["peak_mm"], 0.25);
+  EXPECT_EQ(j[0]["peak_source"], "fit");
+  EXPECT_EQ(j[0]["measured_extreme_mm"], 0.27);
+  EXPECT_EQ(j[0]["noise_mm"], 0.015);
   EXPECT_EQ(j[0]["points"], 180);
   EXPECT_EQ(j[0]["region"], "ridge");
   EXPECT_EQ(DefectsJson(DefectsResult{}), nlohmann::json::array());
@@ -180,6 +187,9 @@ nlohmann::json HandWrittenReport(const ErrorMapResult& r, const ErrorMapSettings
          {"area_mm2", d.area_mm2},
          {"extent_mm", d.extent_mm},
          {"peak_mm", d.peak_mm},
+         {"peak_source", d.peak_fitted ? "fit" : "median"},
+         {"measured_extreme_mm", d.measured_extreme_mm},
+         {"noise_mm", d.noise_mm},
          {"points", d.points},
          {"region", d.region}});
   return j;
@@ -260,6 +270,9 @@ Computed RandomResults(uint32_t seed, bool split) {
     d.area_mm2 = 10 * std::abs(mm(rng));
     d.extent_mm = 3;
     d.peak_mm = mm(rng);
+    d.peak_fitted = k == 1;
+    d.measured_extreme_mm = k == 3 ? NAN : mm(rng);
+    d.noise_mm = 0.015;
     d.points = 40 + k;
     d.region = k == 2 ? "" : "ridge";
     c.outcome.defects.defects.push_back(d);

@@ -52,8 +52,10 @@ class DefectsGroundTruth : public ::testing::Test {
     delete cell_;
   }
 
-  // Simulate view `v` with `defects`, filter (ForInspection), map.
-  static MappedScan Scan(std::size_t v, const std::vector<SurfaceDefect>& defects, uint64_t seed) {
+  // Simulate view `v` of `scene` (default: the part) with `defects`, filter
+  // (ForInspection), map against the part.
+  static MappedScan Scan(std::size_t v, const std::vector<SurfaceDefect>& defects, uint64_t seed,
+                         const TriangleMesh* scene = nullptr, double max_distance_mm = 5.0) {
     const DemoViewpoint& vp = cell_->viewpoints[v];
     ScanOptions opt;
     opt.noise_sigma_mm = 0.015;
@@ -61,8 +63,8 @@ class DefectsGroundTruth : public ::testing::Test {
     opt.stripes = true;
     opt.defects = defects;
     opt.seed = seed;
-    auto scan = SimulateScan(cell_->part, cell_->world_from_part, vp.world_from_sensor,
-                             cell_->intrinsics, opt);
+    auto scan = SimulateScan(scene ? *scene : cell_->part, cell_->world_from_part,
+                             vp.world_from_sensor, cell_->intrinsics, opt);
     EXPECT_TRUE(scan.ok()) << scan.status();
     auto clusters = ClusterLinks(scan->cloud_in_sensor, LinkClusteringSettings::ForInspection());
     EXPECT_TRUE(clusters.ok()) << clusters.status();
@@ -72,6 +74,7 @@ class DefectsGroundTruth : public ::testing::Test {
     out.cloud_in_world = TransformCloud(*filtered, vp.world_from_sensor);
     ErrorMapSettings es;
     es.tolerance_mm = 0.3;
+    es.max_distance_mm = max_distance_mm;
     auto em = ComputeErrorMap(*index_, out.cloud_in_world, cell_->world_from_part, es);
     EXPECT_TRUE(em.ok()) << em.status();
     out.error_map = *std::move(em);
@@ -136,6 +139,21 @@ void Score(const std::vector<SurfaceDefect>& planted, const DefectsResult& found
     }
 }
 
+// The independent bound on every peak: no more than the largest |deviation|
+// measured within the defect's reach, plus 3 sigma of the scan noise.
+void ExpectPeaksWithinMeasured(const DefectsResult& found, const ErrorMapResult& em) {
+  constexpr double kNoiseMm = 0.015;
+  for (const Defect& d : found.defects) {
+    double largest = 0;
+    for (std::size_t i = 0; i < em.deviation_mm.size(); ++i)
+      if (!std::isnan(em.deviation_mm[i]) &&
+          (em.closest_point[i].cast<double>() - d.centroid_mm).norm() <= d.extent_mm + 30)
+        largest = std::max(largest, std::abs(double{em.deviation_mm[i]}));
+    EXPECT_LE(std::abs(d.peak_mm), largest + 3 * kNoiseMm)
+        << "defect " << d.id << " at " << d.centroid_mm.transpose();
+  }
+}
+
 // Six defects along the ridge per scan, 36 mm apart so their profiles do
 // not overlap; depths and radii cover 0.05-0.5 mm and 3-8 mm, both kinds.
 std::vector<std::vector<SurfaceDefect>> PlantedSets() {
@@ -168,6 +186,7 @@ TEST_F(DefectsGroundTruth, FindsPlantedDentsAndBumpsOnSingleViews) {
               << " s\n";
     EXPECT_TRUE(found->organized_path);
     Score(sets[s], *found, t);
+    ExpectPeaksWithinMeasured(*found, m.error_map);
   }
   std::cout << "deep found " << t.found_deep << "/" << t.planted_deep << ", shallow "
             << t.found_shallow << "/" << t.planted_shallow << ", false " << t.false_defects
@@ -231,6 +250,7 @@ TEST_F(DefectsGroundTruth, MergedViewsUseTheUnorganizedPath) {
   EXPECT_FALSE(found->organized_path);
   Tally t;
   Score(planted, *found, t);
+  ExpectPeaksWithinMeasured(*found, *em);
   EXPECT_EQ(t.found_deep, 3);
   EXPECT_EQ(t.found_shallow, 1);
   EXPECT_LE(t.worst_centroid_mm, 1.0);
@@ -349,6 +369,62 @@ TEST(Defects, NamesTheRegionAndRefusesBadInput) {
             absl::StatusCode::kInvalidArgument);
   PointCloud shorter = PointCloud::Unorganized({Eigen::Vector3f::Zero()});
   EXPECT_FALSE(FindDefects(s.error_map, shorter, s.mesh, Rules()).ok());
+}
+
+// A dent cut by the part's end (x = +-150): the thresholded patch is a
+// half-disc whose area-weighted centroid lies ~0.6-1.5 mm inside the part;
+// the fitted Gaussian's centre does not move. Found in a pillar scan where a
+// -0.31 mm dent of radius 6.6 mm was reported 1.5 mm from its centre.
+TEST_F(DefectsGroundTruth, ADentCutByThePartsEndIsPlacedAtItsCentre) {
+  for (auto [v, x] : {std::pair<std::size_t, double>{0, -146}, {4, 146.5}}) {
+    const std::vector<SurfaceDefect> planted = {Planted(x, 9, 0.31, 6.6)};
+    const MappedScan m = Scan(v, planted, 700 + v);
+    auto found = FindDefects(m.error_map, m.cloud_in_world, cell_->part, Rules());
+    ASSERT_TRUE(found.ok()) << found.status();
+    ASSERT_EQ(found->defects.size(), 1u);
+    const Defect& d = found->defects[0];
+    std::cout << "dent at x " << x << ": centre error "
+              << (d.centroid_mm - planted[0].center_in_part).norm() << " mm, peak " << d.peak_mm
+              << "\n";
+    EXPECT_TRUE(d.peak_fitted);
+    EXPECT_LE((d.centroid_mm - planted[0].center_in_part).norm(), 0.11);
+    EXPECT_NEAR(d.peak_mm, -0.31, 0.01);
+  }
+}
+
+// The pillar on a fixture: plates 1.2 mm under the flanges, whose points
+// just beyond the flange edges lie within a 2 mm --max-distance and are
+// matched to the edge with deviations up to ~2 mm. A Gaussian fitted beside
+// them diverged (peaks of -2825 and -3.7e6 mm); every peak must now stay
+// within what was measured, and the planted bump is still fitted.
+TEST_F(DefectsGroundTruth, APeakBesideFixturePointsStaysWithinWhatWasMeasured) {
+  TriangleMesh scene = cell_->part;
+  for (float side : {-1.0f, 1.0f}) {
+    const auto b = static_cast<uint32_t>(scene.vertices.size());
+    for (auto [x, y] : {std::pair{-200.f, 60.f}, {200.f, 60.f}, {200.f, 110.f}, {-200.f, 110.f}})
+      scene.vertices.emplace_back(x, side * y, -1.2f);
+    const uint32_t c = side > 0 ? b + 1 : b + 2, e = side > 0 ? b + 2 : b + 1;
+    scene.triangles.push_back({b, c, e});
+    scene.triangles.push_back({b, side > 0 ? b + 2 : b + 3, side > 0 ? b + 3 : b + 2});
+  }
+  for (std::size_t v : {1, 2}) {
+    const double x = -120 + 60.0 * static_cast<double>(v);
+    SurfaceDefect bump;
+    bump.center_in_part = {x, -74, -3.0 * (x / 150) * (x / 150)};  // on the flange
+    bump.depth_mm = -0.3;
+    bump.radius_mm = 4;
+    const MappedScan m = Scan(v, {bump}, 900 + v, &scene, 2.0);
+    auto found = FindDefects(m.error_map, m.cloud_in_world, cell_->part, Rules());
+    ASSERT_TRUE(found.ok()) << found.status();
+    ExpectPeaksWithinMeasured(*found, m.error_map);
+    int planted_found = 0;
+    for (const Defect& d : found->defects) {
+      if ((d.centroid_mm - bump.center_in_part).norm() < 1.0 && d.peak_fitted)
+        planted_found += std::abs(d.peak_mm - 0.3) < 0.02;
+      EXPECT_LE(std::abs(d.peak_mm), std::abs(d.measured_extreme_mm) + 3 * d.noise_mm + 1e-9);
+    }
+    EXPECT_EQ(planted_found, 1) << "view " << v;
+  }
 }
 
 }  // namespace

@@ -39,7 +39,7 @@ nlohmann::json Report() {
        "tolerance_mm": {"lower": -0.1, "upper": 0.1}, "points": 0, "min_mm": null,
        "max_mm": null, "mean_mm": null, "value_mm": null, "fraction_within": null}],
     "defects": [{"id": 4, "kind": "dent", "centroid_mm": [1.0, 2.0, 3.5], "area_mm2": 12.25,
-                 "extent_mm": 4.0, "peak_mm": -0.3, "points": 40, "region": "ridge"}]
+                 "extent_mm": 4.0, "peak_mm": -0.3, "peak_source": "fit", "points": 40, "region": "ridge"}]
   })");
 }
 
@@ -85,8 +85,8 @@ TEST(ReportContent, DefectsStatisticsAndHistogram) {
   ASSERT_EQ(c->defect_marks.size(), 1u);
   EXPECT_EQ(c->defect_marks[0].id, 4);
   EXPECT_EQ(c->defect_marks[0].centroid_mm, Eigen::Vector3d(1.0, 2.0, 3.5));
-  EXPECT_EQ(c->defects.rows[0], (std::vector<std::string>{"4", "dent", "ridge", "-0.300", "12.2",
-                                                          "4.0", "40", "1.0, 2.0, 3.5"}));
+  EXPECT_EQ(c->defects.rows[0], (std::vector<std::string>{"4", "dent", "ridge", "-0.300", "fit",
+                                                          "12.2", "4.0", "40", "1.0, 2.0, 3.5"}));
   EXPECT_EQ(c->histogram.counts, (std::vector<std::size_t>{1, 6, 1}));
   EXPECT_DOUBLE_EQ(c->tolerance_mm, 0.2);
   EXPECT_DOUBLE_EQ(c->color_range_mm, 0.5);
