@@ -12,7 +12,10 @@
 #include <functional>
 
 #include "core/plan/characteristics.h"
+#include "core/plan/coverage.h"
 #include "core/plan/defects.h"
+#include "core/plan/plan_evaluation.h"
+#include "core/plan/surface_neighbourhood.h"
 #include "core/simulation/demo_cell.h"
 #include "core/types/transform.h"
 
@@ -92,6 +95,14 @@ int Run() {
   const double t_defects =
       BestOf3([&] { defects = FindDefects(*em, cloud, cell.part, rules, &*rp, ds); });
   if (!defects.ok()) return 1;
+  absl::StatusOr<CoverageResult> coverage;
+  CoverageSettings cov;
+  cov.threads = 2;
+  const double t_coverage = BestOf3([&] {
+    cov.distance_mm = kCoverageSpacings * EstimateSurfaceSpacing(*em, cloud);
+    coverage = ComputeCoverage(*em, cell.part, *rp, cov);
+  });
+  if (!coverage.ok()) return 1;
 
   std::printf("%zu points, %.0f matched, %zu triangles\n", cloud.size(), matched,
               cell.part.num_triangles());
@@ -105,6 +116,11 @@ int Run() {
       "defect detection   %8.1f ms  %6.1f ns/matched point  %5.1f%% of the error map,"
       " %zu defects\n",
       1e3 * t_defects, 1e9 * t_defects / matched, 100 * t_defects / t_map, defects->defects.size());
+  std::printf(
+      "coverage           %8.1f ms  %6.1f ns/matched point  %5.1f%% of the error map,"
+      " %.1f%% of the surface within %.2f mm\n",
+      1e3 * t_coverage, 1e9 * t_coverage / matched, 100 * t_coverage / t_map,
+      100 * coverage->surface, coverage->distance_mm);
   for (const Defect& d : defects->defects)
     std::printf("  defect %d %s at (%.2f, %.2f, %.2f) peak %.4f mm area %.1f mm2\n", d.id,
                 DefectKindName(d.kind), d.centroid_mm.x(), d.centroid_mm.y(), d.centroid_mm.z(),

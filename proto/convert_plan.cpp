@@ -13,6 +13,7 @@ absl::StatusOr<PlanRegion> RegionFromProto(const v1::PlanRegion& msg, const std:
   if (msg.has_tolerance_mm()) r.tolerance = BandFromProto(msg.tolerance_mm());
   if (msg.has_allowed_fraction_outside())
     r.allowed_fraction_outside = msg.allowed_fraction_outside();
+  if (msg.has_min_coverage()) r.min_coverage = msg.min_coverage();
   const v1::RegionSelect& s = msg.select();
   switch (s.selector_case()) {
     case v1::RegionSelect::kBoxMm: {
@@ -53,6 +54,7 @@ absl::StatusOr<ComparisonPoint> PointFromProto(const v1::ComparisonPoint& msg,
   }
   if (msg.has_radius_mm()) p.radius_mm = msg.radius_mm();
   if (msg.has_tolerance_mm()) p.tolerance = BandFromProto(msg.tolerance_mm());
+  if (msg.has_min_coverage()) p.min_coverage = msg.min_coverage();
   return p;
 }
 
@@ -65,6 +67,9 @@ absl::StatusOr<InspectionPlan> PlanFromProto(const v1::InspectionPlan& msg,
   if (msg.has_tolerance_mm()) plan.tolerance = BandFromProto(msg.tolerance_mm());
   if (msg.has_allowed_fraction_outside())
     plan.allowed_fraction_outside = msg.allowed_fraction_outside();
+  plan.min_coverage = msg.has_min_coverage() ? msg.min_coverage() : kDefaultMinCoverage;
+  if (msg.has_coverage_distance_mm()) plan.coverage_distance_mm = msg.coverage_distance_mm();
+  plan.allow_not_measured = msg.allow_not_measured();
   for (int i = 0; i < msg.regions_size(); ++i) {
     ASSIGN_OR_RETURN(auto r,
                      RegionFromProto(msg.regions(i), absl::StrCat(field, ".regions[", i, "]")));
@@ -90,11 +95,15 @@ void PlanToProto(const InspectionPlan& plan, v1::InspectionPlan* msg) {
   msg->Clear();
   BandToProto(plan.tolerance, msg->mutable_tolerance_mm());
   msg->set_allowed_fraction_outside(plan.allowed_fraction_outside);
+  msg->set_min_coverage(plan.min_coverage);
+  msg->set_coverage_distance_mm(plan.coverage_distance_mm);
+  msg->set_allow_not_measured(plan.allow_not_measured);
   for (const PlanRegion& r : plan.regions) {
     v1::PlanRegion* m = msg->add_regions();
     m->set_name(r.name);
     if (r.tolerance) BandToProto(*r.tolerance, m->mutable_tolerance_mm());
     m->set_allowed_fraction_outside(r.allowed_fraction_outside);
+    if (r.min_coverage) m->set_min_coverage(*r.min_coverage);
     v1::RegionSelect* s = m->mutable_select();
     switch (r.select.kind) {
       case RegionSelector::Kind::kBox:
@@ -117,6 +126,7 @@ void PlanToProto(const InspectionPlan& plan, v1::InspectionPlan* msg) {
     if (p.normal != Eigen::Vector3d::Zero()) Vector3ToProto(p.normal, m->mutable_normal());
     m->set_radius_mm(p.radius_mm);
     if (p.tolerance) BandToProto(*p.tolerance, m->mutable_tolerance_mm());
+    if (p.min_coverage) m->set_min_coverage(*p.min_coverage);
   }
   if (plan.defects) {
     v1::DefectRules* d = msg->mutable_defects();

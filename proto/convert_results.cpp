@@ -96,7 +96,9 @@ v1::CharacteristicType TypeToProto(CharacteristicType t) {
 void CharacteristicToProto(const CharacteristicResult& c, v1::CharacteristicResult* msg) {
   msg->set_name(c.name);
   msg->set_type(TypeToProto(c.type));
-  msg->set_verdict(VerdictOf(c.pass));
+  msg->set_verdict(c.pass       ? v1::VERDICT_PASS
+                   : c.measured ? v1::VERDICT_FAIL
+                                : v1::VERDICT_NOT_MEASURED);
   msg->set_reason(c.reason);
   BandToProto(c.tolerance, msg->mutable_tolerance_mm());
   msg->set_points(c.points);
@@ -108,6 +110,8 @@ void CharacteristicToProto(const CharacteristicResult& c, v1::CharacteristicResu
   msg->set_fraction_within(c.fraction_within);
   msg->set_value_mm(c.value_mm);
   msg->set_allowed_fraction_outside(c.allowed_fraction_outside);
+  msg->set_coverage(c.coverage);
+  msg->set_min_coverage(c.min_coverage);
 }
 
 void DefectToProto(const Defect& d, v1::DefectResult* msg) {
@@ -148,6 +152,9 @@ CharacteristicsResult CharacteristicsFromProto(
              : m.type() == v1::CHARACTERISTIC_POINT ? CharacteristicType::kPoint
                                                     : CharacteristicType::kSurface;
     c.pass = m.verdict() == v1::VERDICT_PASS;
+    c.measured = m.verdict() != v1::VERDICT_NOT_MEASURED;
+    c.coverage = m.coverage();
+    c.min_coverage = m.min_coverage();
     c.reason = m.reason();
     c.tolerance = BandFromProto(m.tolerance_mm());
     c.points = m.points();
@@ -159,7 +166,8 @@ CharacteristicsResult CharacteristicsFromProto(
     c.fraction_within = m.fraction_within();
     c.value_mm = m.value_mm();
     c.allowed_fraction_outside = m.allowed_fraction_outside();
-    out.failed += c.pass ? 0 : 1;
+    out.failed += !c.pass && c.measured;
+    out.not_measured += !c.measured;
     out.characteristics.push_back(std::move(c));
   }
   return out;

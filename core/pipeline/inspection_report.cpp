@@ -26,6 +26,8 @@ void VisitCharacteristic(V& v, R& c) {
   v("verdict", c.verdict);
   v("reason", c.reason);
   v.Object("tolerance_mm", c.tolerance, [](auto& w, auto& b) { VisitBand(w, b); });
+  v("coverage", c.coverage);
+  v("min_coverage", c.min_coverage);
   v("points", c.points);
   v("min_mm", c.min_mm);
   v("max_mm", c.max_mm);
@@ -234,8 +236,10 @@ ReportCharacteristic ReportCharacteristicOf(const CharacteristicResult& c) {
   ReportCharacteristic out;
   out.name = c.name;
   out.type = CharacteristicTypeName(c.type);
-  out.verdict = c.pass ? "pass" : "fail";
+  out.verdict = VerdictName(c);
   out.reason = c.reason;
+  out.coverage = c.coverage;
+  out.min_coverage = c.min_coverage;
   out.tolerance = c.tolerance;
   out.points = c.points;
   out.min_mm = c.min_mm;

@@ -52,16 +52,20 @@ struct ReportTolerance {
 struct ReportCharacteristic {
   std::string name;
   std::string type;                   // "surface" | "region" | "point"
-  std::string verdict;                // "pass" | "fail"
+  std::string verdict;                // "pass" | "fail" | "not_measured"
   std::string reason;                 // one line, for people
   ToleranceBand tolerance{NAN, NAN};  // NaN when not said
-  std::size_t points = 0;             // matched points judged
+  // The covered fraction of its CAD area and the least it needed
+  // (core/plan/coverage.h); NaN in a report from before coverage.
+  double coverage = NAN, min_coverage = NAN;
+  std::size_t points = 0;  // matched points judged
   double min_mm = NAN, max_mm = NAN, mean_mm = NAN, stddev_mm = NAN, rms_mm = NAN;
   double fraction_within = NAN;
   double value_mm = NAN;                  // points only
   double allowed_fraction_outside = NAN;  // surface and regions only
   bool is_point() const { return type == "point"; }
   bool passed() const { return verdict == "pass"; }
+  bool measured() const { return verdict != "not_measured"; }
   bool operator==(const ReportCharacteristic& o) const;
 };
 

@@ -137,7 +137,62 @@ void JudgePoint(double radius_mm, CharacteristicResult& c) {
                       c.tolerance.lower_mm, c.tolerance.upper_mm);
 }
 
+// Not measured when its area was seen over less than it needs.
+void JudgeCoverage(double coverage, double min_coverage, CharacteristicResult& c) {
+  c.coverage = coverage;
+  c.min_coverage = min_coverage;
+  if (!(coverage < min_coverage)) return;
+  c.measured = false;
+  c.pass = false;
+  c.reason = absl::StrFormat(
+      "not measured: %.1f%% of its CAD area seen, at least %.1f%% needed (%u points)",
+      100 * coverage, 100 * min_coverage, c.points);
+}
+
+// The k-th characteristic (surface, regions, points) judged.
+CharacteristicResult Judge(const ErrorMapResult& em, const ResolvedInspectionPlan& rp,
+                           const ToleranceBand& band, const Accumulator& total, std::size_t k,
+                           const CoverageResult* coverage) {
+  CharacteristicResult c;
+  c.tolerance = band;
+  FillStats(total, c);
+  const InspectionPlan& plan = rp.plan;
+  if (k == 0) {
+    c.name = kSurfaceCharacteristicName;
+    c.type = CharacteristicType::kSurface;
+    c.allowed_fraction_outside = plan.allowed_fraction_outside;
+    // The error map's own two-pass statistics, so report blocks agree.
+    c.min_mm = em.stats.min_mm;
+    c.max_mm = em.stats.max_mm;
+    c.mean_mm = em.stats.mean_mm;
+    c.stddev_mm = em.stats.stddev_mm;
+    c.rms_mm = em.stats.rms_mm;
+    JudgeArea(c);
+    if (coverage) JudgeCoverage(coverage->surface, plan.min_coverage, c);
+  } else if (k <= plan.regions.size()) {
+    const PlanRegion& r = plan.regions[k - 1];
+    c.name = r.name;
+    c.type = CharacteristicType::kRegion;
+    c.allowed_fraction_outside = r.allowed_fraction_outside;
+    JudgeArea(c);
+    if (coverage)
+      JudgeCoverage(coverage->regions[k - 1], r.min_coverage.value_or(plan.min_coverage), c);
+  } else {
+    const std::size_t i = k - 1 - plan.regions.size();
+    const ComparisonPoint& p = plan.points[i];
+    c.name = p.name;
+    c.type = CharacteristicType::kPoint;
+    JudgePoint(p.radius_mm, c);
+    if (coverage) JudgeCoverage(coverage->points[i], p.min_coverage.value_or(plan.min_coverage), c);
+  }
+  return c;
+}
+
 }  // namespace
+
+const char* VerdictName(const CharacteristicResult& c) {
+  return c.pass ? "pass" : c.measured ? "fail" : "not_measured";
+}
 
 const char* CharacteristicTypeName(CharacteristicType type) {
   switch (type) {
@@ -153,8 +208,11 @@ const char* CharacteristicTypeName(CharacteristicType type) {
 
 absl::StatusOr<CharacteristicsResult> ComputeCharacteristics(
     const ErrorMapResult& em, const ResolvedInspectionPlan& rp, std::size_t defect_count,
-    const CharacteristicsSettings& settings) {
+    const CharacteristicsSettings& settings, const CoverageResult* coverage) {
   const std::size_t n = em.deviation_mm.size();
+  if (coverage && (coverage->regions.size() != rp.plan.regions.size() ||
+                   coverage->points.size() != rp.plan.points.size()))
+    return absl::InvalidArgumentError("characteristics: the coverage is of another plan");
   if (em.triangle_id.size() != n || em.closest_point.size() != n)
     return absl::InvalidArgumentError("characteristics: error map arrays differ in size");
   if (rp.region_offsets.size() != rp.num_triangles + 1 ||
@@ -182,41 +240,21 @@ absl::StatusOr<CharacteristicsResult> ComputeCharacteristics(
 
   CharacteristicsResult out;
   for (std::size_t k = 0; k < bands.size(); ++k) {
-    CharacteristicResult c;
-    c.tolerance = bands[k];
-    FillStats(total[k], c);
-    if (k == 0) {
-      c.name = kSurfaceCharacteristicName;
-      c.type = CharacteristicType::kSurface;
-      c.allowed_fraction_outside = rp.plan.allowed_fraction_outside;
-      // The error map's own two-pass statistics, so report blocks agree.
-      c.min_mm = em.stats.min_mm;
-      c.max_mm = em.stats.max_mm;
-      c.mean_mm = em.stats.mean_mm;
-      c.stddev_mm = em.stats.stddev_mm;
-      c.rms_mm = em.stats.rms_mm;
-      JudgeArea(c);
-    } else if (k <= rp.plan.regions.size()) {
-      const PlanRegion& r = rp.plan.regions[k - 1];
-      c.name = r.name;
-      c.type = CharacteristicType::kRegion;
-      c.allowed_fraction_outside = r.allowed_fraction_outside;
-      JudgeArea(c);
-    } else {
-      const ComparisonPoint& p = rp.plan.points[k - 1 - rp.plan.regions.size()];
-      c.name = p.name;
-      c.type = CharacteristicType::kPoint;
-      JudgePoint(p.radius_mm, c);
-    }
-    out.failed += c.pass ? 0 : 1;
+    CharacteristicResult c = Judge(em, rp, bands[k], total[k], k, coverage);
+    out.failed += !c.pass && c.measured;
+    out.not_measured += !c.measured;
     out.characteristics.push_back(std::move(c));
   }
   const bool too_many_defects =
       rp.plan.defects && rp.plan.defects->max_count &&
       defect_count > static_cast<std::size_t>(*rp.plan.defects->max_count);
-  out.pass = out.failed == 0 && !too_many_defects;
+  out.pass =
+      out.failed == 0 && (out.not_measured == 0 || rp.plan.allow_not_measured) && !too_many_defects;
   out.reason = absl::StrCat(out.pass ? "pass" : "fail", ": ", out.failed, " of ",
                             out.characteristics.size(), " characteristics fail");
+  if (out.not_measured > 0)
+    absl::StrAppend(&out.reason, ", ", out.not_measured, " not measured",
+                    rp.plan.allow_not_measured ? " (allowed by the plan)" : "");
   if (rp.plan.defects && rp.plan.defects->max_count)
     absl::StrAppend(&out.reason, "; ", defect_count, " defects (at most ",
                     *rp.plan.defects->max_count, " allowed)");

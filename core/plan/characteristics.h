@@ -10,7 +10,11 @@
 //  * A surface or region passes when it has matched points and the fraction
 //    outside its band is at most allowed_fraction_outside; a point passes
 //    when it has a value and that value is inside its band.
-//  * The part passes when every characteristic passes, and, when the plan
+//  * With a coverage (core/plan/coverage.h), a characteristic whose CAD
+//    area was seen over less than its min_coverage is not measured: it
+//    does not pass, whatever its few points say.
+//  * The part passes when every characteristic passes (those not measured
+//    are let through only when the plan allows it), and, when the plan
 //    sets defects.max_count, at most that many defects were found.
 //
 // One pass over the points, with the per-triangle rows of the resolved plan;
@@ -26,6 +30,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/errormap/error_map.h"
+#include "core/plan/coverage.h"
 #include "core/plan/inspection_plan.h"
 
 namespace surfinspect {
@@ -37,7 +42,10 @@ struct CharacteristicResult {
   std::string name;
   CharacteristicType type = CharacteristicType::kSurface;
   bool pass = false;
-  std::string reason;  // one line, for people
+  bool measured = true;     // false: coverage below min_coverage (never passes)
+  double coverage = NAN;    // covered fraction of its CAD area; NaN when not computed
+  double min_coverage = 0;  // the least it needed
+  std::string reason;       // one line, for people
   ToleranceBand tolerance;
   double allowed_fraction_outside = 0;  // surface and regions
   std::size_t points = 0;               // matched points judged
@@ -51,7 +59,8 @@ struct CharacteristicResult {
 struct CharacteristicsResult {
   std::vector<CharacteristicResult> characteristics;  // surface, regions, points, in plan order
   bool pass = false;       // every characteristic passes (and the defect count rule, when set)
-  std::size_t failed = 0;  // characteristics that fail
+  std::size_t failed = 0;  // characteristics that were measured and fail
+  std::size_t not_measured = 0;
   std::string reason;
 };
 
@@ -59,11 +68,16 @@ struct CharacteristicsSettings {
   int threads = 0;  // 0 = all cores; the result is the same for any value
 };
 
+// "pass" | "fail" | "not_measured".
+const char* VerdictName(const CharacteristicResult& c);
+
 // `error_map` must come from the part mesh `plan` was resolved against
 // (triangle ids below plan.num_triangles); InvalidArgument otherwise.
 // `defect_count` feeds the max_count rule; pass 0 when defects were not run.
+// `coverage` (of the same plan and map) is judged when given.
 absl::StatusOr<CharacteristicsResult> ComputeCharacteristics(
     const ErrorMapResult& error_map, const ResolvedInspectionPlan& plan,
-    std::size_t defect_count = 0, const CharacteristicsSettings& settings = {});
+    std::size_t defect_count = 0, const CharacteristicsSettings& settings = {},
+    const CoverageResult* coverage = nullptr);
 
 }  // namespace surfinspect

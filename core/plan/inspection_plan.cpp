@@ -114,6 +114,10 @@ absl::Status ValidateInspectionPlan(const InspectionPlan& plan, const TriangleMe
   if (auto st = CheckFraction(where + ".allowed_fraction_outside", plan.allowed_fraction_outside);
       !st.ok())
     return st;
+  RETURN_IF_ERROR(CheckFraction(where + ".min_coverage", plan.min_coverage));
+  RETURN_IF_ERROR(CheckFinite(where + ".coverage_distance_mm", plan.coverage_distance_mm));
+  if (!(plan.coverage_distance_mm >= 0))
+    return Bad(where + ".coverage_distance_mm", "must be >= 0 (0: 4 sampling spacings)");
   std::set<std::string> names;
   for (std::size_t i = 0; i < plan.regions.size(); ++i) {
     const PlanRegion& r = plan.regions[i];
@@ -124,6 +128,7 @@ absl::Status ValidateInspectionPlan(const InspectionPlan& plan, const TriangleMe
     if (auto st = CheckFraction(path + ".allowed_fraction_outside", r.allowed_fraction_outside);
         !st.ok())
       return st;
+    if (r.min_coverage) RETURN_IF_ERROR(CheckFraction(path + ".min_coverage", *r.min_coverage));
   }
   for (std::size_t i = 0; i < plan.points.size(); ++i) {
     const ComparisonPoint& p = plan.points[i];
@@ -134,6 +139,7 @@ absl::Status ValidateInspectionPlan(const InspectionPlan& plan, const TriangleMe
     RETURN_IF_ERROR(CheckFinite(path + ".radius_mm", p.radius_mm));
     if (!(p.radius_mm > 0)) return Bad(path + ".radius_mm", "must be > 0");
     if (p.tolerance) RETURN_IF_ERROR(CheckBand(path + ".tolerance_mm", *p.tolerance));
+    if (p.min_coverage) RETURN_IF_ERROR(CheckFraction(path + ".min_coverage", *p.min_coverage));
   }
   if (plan.defects) {
     const std::string path = where + ".defects";

@@ -63,6 +63,7 @@ struct PlanRegion {
   RegionSelector select;
   std::optional<ToleranceBand> tolerance;  // unset: the plan's default band
   double allowed_fraction_outside = 0.0;   // of the region's matched points, in [0, 1]
+  std::optional<double> min_coverage;      // unset: the plan's; in [0, 1]
 };
 
 struct ComparisonPoint {
@@ -73,6 +74,7 @@ struct ComparisonPoint {
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
   double radius_mm = 2.0;  // > 0
   std::optional<ToleranceBand> tolerance;
+  std::optional<double> min_coverage;  // of the surface within radius_mm; unset: the plan's
 };
 
 struct DefectRules {
@@ -83,9 +85,22 @@ struct DefectRules {
   std::optional<int> max_count;
 };
 
+// A plan's default least coverage: a characteristic whose CAD area was seen
+// over less is not measured. docs/inspection-plan.md gives the reasons.
+inline constexpr double kDefaultMinCoverage = 0.9;
+
 struct InspectionPlan {
   ToleranceBand tolerance;                // the surface's band and the default
   double allowed_fraction_outside = 0.0;  // for the surface characteristic
+  // Coverage (core/plan/coverage.h): the least covered fraction of each
+  // characteristic's CAD area (the surface, a region, a point's disc) for
+  // it to be measured; in [0, 1], 0 judges whatever was seen. The distance
+  // within which a measured point covers the CAD, mm; 0 = 4 sampling
+  // spacings of the scan. A characteristic not measured fails the part
+  // unless allow_not_measured.
+  double min_coverage = kDefaultMinCoverage;
+  double coverage_distance_mm = 0;
+  bool allow_not_measured = false;
   std::vector<PlanRegion> regions;
   std::vector<ComparisonPoint> points;
   std::optional<DefectRules> defects;  // unset: no defect detection

@@ -57,6 +57,20 @@ absl::StatusOr<std::string> String(const json& j, const std::string& path) {
   return j.get<std::string>();
 }
 
+absl::StatusOr<bool> Bool(const json& j, const std::string& path) {
+  if (!j.is_boolean()) return Bad(path, "must be true or false");
+  return j.get<bool>();
+}
+
+// An optional number: `out` is set when `key` is present.
+template <typename T>
+absl::Status OptionalNumber(const json& j, const char* key, const std::string& path, T& out) {
+  if (!j.contains(key)) return absl::OkStatus();
+  ASSIGN_OR_RETURN(auto v, Number(j[key], absl::StrCat(path, ".", key)));
+  out = v;
+  return absl::OkStatus();
+}
+
 absl::StatusOr<ToleranceBand> Band(const json& j, const std::string& path) {
   if (auto st = CheckKeys(j, path, {"lower", "upper"}); !st.ok()) return st;
   if (!j.contains("lower") || !j.contains("upper")) return Bad(path, "needs lower and upper");
@@ -101,7 +115,8 @@ absl::StatusOr<RegionSelector> Selector(const json& j, const std::string& path) 
 }
 
 absl::StatusOr<PlanRegion> Region(const json& j, const std::string& path) {
-  if (auto st = CheckKeys(j, path, {"name", "select", "tolerance_mm", "allowed_fraction_outside"});
+  if (auto st = CheckKeys(
+          j, path, {"name", "select", "tolerance_mm", "allowed_fraction_outside", "min_coverage"});
       !st.ok())
     return st;
   PlanRegion r;
@@ -119,11 +134,13 @@ absl::StatusOr<PlanRegion> Region(const json& j, const std::string& path) {
                      Number(j["allowed_fraction_outside"], path + ".allowed_fraction_outside"));
     r.allowed_fraction_outside = f;
   }
+  RETURN_IF_ERROR(OptionalNumber(j, "min_coverage", path, r.min_coverage));
   return r;
 }
 
 absl::StatusOr<ComparisonPoint> Point(const json& j, const std::string& path) {
-  if (auto st = CheckKeys(j, path, {"name", "position_mm", "normal", "radius_mm", "tolerance_mm"});
+  if (auto st = CheckKeys(
+          j, path, {"name", "position_mm", "normal", "radius_mm", "tolerance_mm", "min_coverage"});
       !st.ok())
     return st;
   ComparisonPoint p;
@@ -146,6 +163,7 @@ absl::StatusOr<ComparisonPoint> Point(const json& j, const std::string& path) {
     ASSIGN_OR_RETURN(auto b, Band(j["tolerance_mm"], path + ".tolerance_mm"));
     p.tolerance = b;
   }
+  RETURN_IF_ERROR(OptionalNumber(j, "min_coverage", path, p.min_coverage));
   return p;
 }
 
@@ -185,9 +203,10 @@ absl::Status List(const json& j, const std::string& path, F parse, std::vector<T
 absl::StatusOr<InspectionPlan> ParseInspectionPlan(const json& j, const TriangleMesh& part,
                                                    const std::string& where,
                                                    const MeshGroups& groups) {
-  if (auto st = CheckKeys(
-          j, where,
-          {"schema", "tolerance_mm", "allowed_fraction_outside", "regions", "points", "defects"});
+  if (auto st =
+          CheckKeys(j, where,
+                    {"schema", "tolerance_mm", "allowed_fraction_outside", "min_coverage",
+                     "coverage_distance_mm", "allow_not_measured", "regions", "points", "defects"});
       !st.ok())
     return st;
   InspectionPlan plan;
@@ -205,6 +224,12 @@ absl::StatusOr<InspectionPlan> ParseInspectionPlan(const json& j, const Triangle
     ASSIGN_OR_RETURN(auto f,
                      Number(j["allowed_fraction_outside"], where + ".allowed_fraction_outside"));
     plan.allowed_fraction_outside = f;
+  }
+  RETURN_IF_ERROR(OptionalNumber(j, "min_coverage", where, plan.min_coverage));
+  RETURN_IF_ERROR(OptionalNumber(j, "coverage_distance_mm", where, plan.coverage_distance_mm));
+  if (j.contains("allow_not_measured")) {
+    ASSIGN_OR_RETURN(plan.allow_not_measured,
+                     Bool(j["allow_not_measured"], where + ".allow_not_measured"));
   }
   if (j.contains("regions"))
     RETURN_IF_ERROR(List(j["regions"], where + ".regions", Region, plan.regions));

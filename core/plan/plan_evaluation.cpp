@@ -2,6 +2,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/io/io_mesh.h"
+#include "core/plan/surface_neighbourhood.h"
 #include "core/types/status_macros.h"
 
 namespace surfinspect {
@@ -10,6 +11,9 @@ InspectionPlan PlanFromSettings(const ErrorMapSettings& settings) {
   InspectionPlan plan;
   plan.tolerance = {-settings.tolerance_mm, settings.tolerance_mm};
   plan.allowed_fraction_outside = settings.allowed_fraction_outside;
+  // Without a plan the points given are judged (a single view of a part is
+  // a valid error map); coverage is reported, not required.
+  plan.min_coverage = 0;
   return plan;
 }
 
@@ -45,8 +49,15 @@ absl::StatusOr<PlanOutcome> EvaluatePlan(const ErrorMapResult& error_map, const 
                                          int threads) {
   ASSIGN_OR_RETURN(auto resolved, ResolveInspectionPlan(plan, part));
   PlanOutcome out;
+  const double spacing = EstimateSurfaceSpacing(error_map, cloud);
+  CoverageSettings cov;
+  cov.distance_mm =
+      plan.coverage_distance_mm > 0 ? plan.coverage_distance_mm : kCoverageSpacings * spacing;
+  cov.threads = threads;
+  ASSIGN_OR_RETURN(out.coverage, ComputeCoverage(error_map, part, resolved, cov));
   if (plan.defects) {
     DefectSettings ds;
+    ds.spacing_mm = spacing;
     ds.threads = threads;
     ASSIGN_OR_RETURN(out.defects,
                      FindDefects(error_map, cloud, part, *plan.defects, &resolved, ds));
@@ -54,8 +65,9 @@ absl::StatusOr<PlanOutcome> EvaluatePlan(const ErrorMapResult& error_map, const 
   }
   CharacteristicsSettings cs;
   cs.threads = threads;
-  ASSIGN_OR_RETURN(out.characteristics,
-                   ComputeCharacteristics(error_map, resolved, out.defects.defects.size(), cs));
+  ASSIGN_OR_RETURN(
+      out.characteristics,
+      ComputeCharacteristics(error_map, resolved, out.defects.defects.size(), cs, &out.coverage));
   return out;
 }
 

@@ -52,8 +52,15 @@ absl::StatusOr<InspectionPlan> ParsePlanForMeshFile(const nlohmann::json& json,
                                                     const std::string& where = "plan",
                                                     LengthUnit file_unit = LengthUnit::kMillimetre);
 
+// The default coverage distance in sampling spacings: a CAD location within
+// 4 spacings of a measured point was seen. A wall at 75 degrees incidence is
+// sampled ~3.9x coarser along its slope; its farthest location from a
+// sample is ~2 spacings away, so it still counts as seen.
+inline constexpr double kCoverageSpacings = 4.0;
+
 struct PlanOutcome {
   CharacteristicsResult characteristics;  // surface, regions, points
+  CoverageResult coverage;                // of the same characteristics
   bool defects_run = false;               // the plan has defect rules
   DefectsResult defects;                  // empty unless defects_run
   bool pass() const { return characteristics.pass; }

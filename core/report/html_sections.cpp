@@ -6,6 +6,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "core/report/html_escape.h"
+#include "core/report/report_content.h"
 
 namespace surfinspect {
 namespace {
@@ -48,7 +49,8 @@ std::string Band(const ToleranceBand& tolerance) {
 
 std::string VerdictCell(const std::string& v) {
   const std::string s = v.empty() ? "?" : v;
-  return absl::StrCat("<td class=\"", s == "pass" ? "pass" : "fail", "\">", HtmlEscape(s), "</td>");
+  const char* cls = s == "pass" ? "pass" : s == "not_measured" ? "unmeasured" : "fail";
+  return absl::StrCat("<td class=\"", cls, "\">", HtmlEscape(s), "</td>");
 }
 
 std::string Rows(const std::vector<ReportField>& fields, const std::string& prefix,
@@ -82,7 +84,7 @@ std::string CharacteristicsTable(const InspectionReport& report) {
   std::string out =
       "<table id=\"characteristics\"><thead><tr><th>name</th><th>type</th><th>verdict</th>"
       "<th>band mm</th><th>value/mean mm</th><th>min mm</th><th>max mm</th><th>within</th>"
-      "<th>points</th></tr></thead><tbody>\n";
+      "<th>points</th><th>coverage</th></tr></thead><tbody>\n";
   for (const ReportCharacteristic& c : rows) {
     const double value = c.is_point() && !std::isnan(c.value_mm) ? c.value_mm : c.mean_mm;
     const double within = c.fraction_within;
@@ -90,7 +92,7 @@ std::string CharacteristicsTable(const InspectionReport& report) {
                     VerdictCell(c.verdict), Td(Band(c.tolerance)), Td(JsonNumber(value)),
                     Td(JsonNumber(c.min_mm)), Td(JsonNumber(c.max_mm)),
                     Td(std::isnan(within) ? json() : json(absl::StrFormat("%.2f%%", 100 * within))),
-                    Td(c.points), "</tr>\n");
+                    Td(c.points), Td(CoverageText(c)), "</tr>\n");
   }
   return out + "</tbody></table>\n";
 }

@@ -46,7 +46,7 @@ void AddStatistics(const InspectionReport& r, ReportContent& c) {
 void AddCharacteristics(const std::vector<ReportCharacteristic>& list, ReportContent& c) {
   ReportTable& t = c.characteristics;
   t.header = {"characteristic", "type",   "verdict", "tolerance mm", "value / mean mm",
-              "min mm",         "max mm", "in tol",  "points"};
+              "min mm",         "max mm", "in tol",  "points",       "coverage"};
   std::vector<std::size_t> order(list.size());
   std::iota(order.begin(), order.end(), 0);
   std::stable_partition(order.begin(), order.end(),
@@ -57,7 +57,7 @@ void AddCharacteristics(const std::vector<ReportCharacteristic>& list, ReportCon
         {ch.name, ch.type, ch.verdict,
          absl::StrCat(FormatMm(ch.tolerance.lower_mm), " / ", FormatMm(ch.tolerance.upper_mm)),
          FormatMm(ch.is_point() ? ch.value_mm : ch.mean_mm), FormatMm(ch.min_mm),
-         FormatMm(ch.max_mm), Percent(ch.fraction_within), Count(ch.points)});
+         FormatMm(ch.max_mm), Percent(ch.fraction_within), Count(ch.points), CoverageText(ch)});
     t.failed.push_back(!ch.passed());
   }
 }
@@ -81,6 +81,14 @@ void AddDefects(const std::vector<ReportDefect>& list, ReportContent& c) {
 }
 
 }  // namespace
+
+std::string CoverageText(const ReportCharacteristic& c) {
+  if (std::isnan(c.coverage)) return "-";
+  std::string s = absl::StrFormat("%.1f%%", 100 * c.coverage);
+  if (c.min_coverage > 0)
+    absl::StrAppend(&s, absl::StrFormat(" (min %.0f%%)", 100 * c.min_coverage));
+  return s;
+}
 
 std::string FormatMm(double v) { return std::isfinite(v) ? absl::StrFormat("%+.3f", v) : "-"; }
 

@@ -29,14 +29,18 @@ struct ReportContent {
   std::string reason;   // the +-tolerance verdict's one line
   double tolerance_mm = 0, color_range_mm = 0;
   std::vector<std::pair<std::string, std::string>> statistics;  // label, value
-  ReportTable characteristics;  // name, type, verdict, tolerance, value, min, max, in tol, points
-  ReportTable defects;          // id, kind, region, peak, area, extent, points, centroid
+  // name, type, verdict, tolerance, value, min, max, in tol, points, coverage
+  ReportTable characteristics;
+  ReportTable defects;  // id, kind, region, peak, peak from, area, extent, points, centroid
   std::vector<Defect> defect_marks;  // id and centroid of each defect, for the map
   Histogram histogram;
 };
 
 // A millimetre value as the report prints it: "%+.3f", "-" for null/NaN.
 std::string FormatMm(double v);
+// A characteristic's coverage as the reports print it: "97.3% (min 90%)",
+// "-" when the report has none.
+std::string CoverageText(const ReportCharacteristic& c);
 
 // DataLoss unless the report has its tolerance band and colour range (both
 // > 0). Missing counts, statistics, histogram, characteristics or defects

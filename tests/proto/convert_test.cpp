@@ -239,18 +239,21 @@ TEST(PlanProto, RoundTripsEveryFieldAndUnsetBandsTakeTheSettings) {
   InspectionPlan plan;
   plan.tolerance = {-0.05, 0.15};
   plan.allowed_fraction_outside = 0.01;
-  PlanRegion box{"box", {}, ToleranceBand{-0.2, 0.1}, 0.5};
+  plan.min_coverage = 0.75;
+  plan.coverage_distance_mm = 1.5;
+  plan.allow_not_measured = true;
+  PlanRegion box{"box", {}, ToleranceBand{-0.2, 0.1}, 0.5, 0.6};
   box.select.box_min_mm = {-1, -2, -3};
   box.select.box_max_mm = {4, 5, 6};
-  PlanRegion tris{"tris", {}, {}, 0};
+  PlanRegion tris{"tris", {}, {}, 0, {}};
   tris.select.kind = RegionSelector::Kind::kTriangles;
   tris.select.triangles = {0, 7, 3};
-  PlanRegion group{"group", {}, {}, 0};
+  PlanRegion group{"group", {}, {}, 0, {}};
   group.select.kind = RegionSelector::Kind::kGroup;
   group.select.group = "flange";
   plan.regions = {box, tris, group};
-  plan.points = {{"P1", {1, 2, 3}, {0, 0, 1}, 2.5, ToleranceBand{-0.1, 0.3}},
-                 {"P2", {4, 5, 6}, {}, 2.0, {}}};
+  plan.points = {{"P1", {1, 2, 3}, {0, 0, 1}, 2.5, ToleranceBand{-0.1, 0.3}, 0.4},
+                 {"P2", {4, 5, 6}, {}, 2.0, {}, {}}};
   plan.defects = DefectRules{0.03, 4.0, 2};
   v1::InspectionPlan msg;
   PlanToProto(plan, &msg);
@@ -264,6 +267,12 @@ TEST(PlanProto, RoundTripsEveryFieldAndUnsetBandsTakeTheSettings) {
   EXPECT_FALSE(back->points[1].tolerance.has_value());
   EXPECT_EQ(*back->defects->max_count, 2);
   EXPECT_EQ(back->tolerance.upper_mm, 0.15);
+  EXPECT_EQ(back->min_coverage, 0.75);
+  EXPECT_EQ(back->coverage_distance_mm, 1.5);
+  EXPECT_TRUE(back->allow_not_measured);
+  EXPECT_EQ(*back->regions[0].min_coverage, 0.6);
+  EXPECT_FALSE(back->regions[1].min_coverage.has_value());
+  EXPECT_EQ(*back->points[0].min_coverage, 0.4);
   // An empty message: the surface against +-tolerance_mm, no defects.
   ErrorMapSettings s;
   s.tolerance_mm = 0.3;
@@ -273,6 +282,8 @@ TEST(PlanProto, RoundTripsEveryFieldAndUnsetBandsTakeTheSettings) {
   EXPECT_EQ(empty->tolerance.lower_mm, -0.3);
   EXPECT_EQ(empty->tolerance.upper_mm, 0.3);
   EXPECT_EQ(empty->allowed_fraction_outside, 0.001);
+  EXPECT_EQ(empty->min_coverage, kDefaultMinCoverage) << "a plan's default, as in the JSON";
+  EXPECT_FALSE(empty->allow_not_measured);
   EXPECT_FALSE(empty->defects.has_value());
 }
 

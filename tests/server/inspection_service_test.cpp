@@ -111,7 +111,13 @@ void ExpectTypedEqualsJson(const Msg& m) {
     const v1::CharacteristicResult& c = m.characteristics(i);
     const nlohmann::json& cj = j["characteristics"][i];
     EXPECT_EQ(c.name(), cj["name"]);
-    EXPECT_EQ(c.verdict() == v1::VERDICT_PASS ? "pass" : "fail", cj["verdict"]) << c.name();
+    EXPECT_EQ(c.verdict() == v1::VERDICT_PASS   ? "pass"
+              : c.verdict() == v1::VERDICT_FAIL ? "fail"
+                                                : "not_measured",
+              cj["verdict"])
+        << c.name();
+    ExpectSame(c.coverage(), cj["coverage"], c.name() + " coverage");
+    ExpectSame(c.min_coverage(), cj["min_coverage"], c.name() + " min coverage");
     EXPECT_EQ(c.reason(), cj["reason"]);
     EXPECT_EQ(c.points(), cj["points"]);
     EXPECT_EQ(c.tolerance_mm().lower_mm(), cj["tolerance_mm"]["lower"]);
@@ -174,7 +180,8 @@ TEST(InspectionService, ThePlanTravelsTypedAndTheResultsAreTypedToo) {
   local.erase("timing");
   EXPECT_EQ(remote, local);
   EXPECT_EQ(remote["characteristics"].size(), 4u);
-  EXPECT_EQ(eresp->characteristics(3).reason().substr(0, 16), "fail: unmeasured");
+  EXPECT_EQ(eresp->characteristics(3).reason().substr(0, 13), "not measured:");
+  EXPECT_EQ(eresp->characteristics(3).verdict(), v1::VERDICT_NOT_MEASURED);
 
   // Inspect: the plan in the part header.
   v1::PartHeader header;

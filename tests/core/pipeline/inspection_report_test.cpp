@@ -34,7 +34,10 @@ TEST(InspectionReport, CharacteristicsCarryTheSchemaFields) {
   CharacteristicResult point;
   point.name = "P1";
   point.type = CharacteristicType::kPoint;
-  point.reason = "fail: unmeasured";
+  point.reason = "not measured: 0.0% of its CAD area seen";
+  point.measured = false;
+  point.coverage = 0;
+  point.min_coverage = 0.9;
   r.characteristics = {surface, point};
 
   const nlohmann::json j = CharacteristicsJson(r);
@@ -42,7 +45,8 @@ TEST(InspectionReport, CharacteristicsCarryTheSchemaFields) {
   ASSERT_EQ(j.size(), 2u);
   const std::set<std::string> common = {"name",         "type",      "verdict", "reason",
                                         "tolerance_mm", "points",    "min_mm",  "max_mm",
-                                        "mean_mm",      "stddev_mm", "rms_mm",  "fraction_within"};
+                                        "mean_mm",      "stddev_mm", "rms_mm",  "fraction_within",
+                                        "coverage",     "min_coverage"};
   std::set<std::string> area_keys = common, point_keys = common;
   area_keys.insert("allowed_fraction_outside");
   point_keys.insert("value_mm");
@@ -56,7 +60,10 @@ TEST(InspectionReport, CharacteristicsCarryTheSchemaFields) {
   EXPECT_EQ(j[0]["rms_mm"], 0.03);
   EXPECT_EQ(j[0]["fraction_within"], 0.9);
   EXPECT_EQ(j[1]["type"], "point");
-  EXPECT_EQ(j[1]["verdict"], "fail");
+  EXPECT_EQ(j[1]["verdict"], "not_measured");
+  EXPECT_EQ(j[1]["coverage"], 0.0);
+  EXPECT_EQ(j[1]["min_coverage"], 0.9);
+  EXPECT_TRUE(j[0]["coverage"].is_null()) << "not computed";
   EXPECT_TRUE(j[1]["value_mm"].is_null()) << "unmeasured";
   EXPECT_TRUE(j[1]["mean_mm"].is_null());
   EXPECT_EQ(j[1]["points"], 0);
@@ -161,9 +168,11 @@ nlohmann::json HandWrittenReport(const ErrorMapResult& r, const ErrorMapSettings
     nlohmann::json k = {
         {"name", c.name},
         {"type", CharacteristicTypeName(c.type)},
-        {"verdict", c.pass ? "pass" : "fail"},
+        {"verdict", c.pass ? "pass" : c.measured ? "fail" : "not_measured"},
         {"reason", c.reason},
         {"tolerance_mm", {{"lower", c.tolerance.lower_mm}, {"upper", c.tolerance.upper_mm}}},
+        {"coverage", Or(c.coverage)},
+        {"min_coverage", c.min_coverage},
         {"points", c.points},
         {"min_mm", Or(c.min_mm)},
         {"max_mm", Or(c.max_mm)},
@@ -248,6 +257,9 @@ Computed RandomResults(uint32_t seed, bool split) {
     ch.name = "c\"" + std::to_string(k) + "\\u00e9";
     ch.type = static_cast<CharacteristicType>(k % 3);
     ch.pass = k % 2;
+    ch.measured = k != 2;
+    ch.coverage = k == 0 ? NAN : 0.25 * k;
+    ch.min_coverage = 0.9;
     ch.reason = "why " + std::to_string(k);
     ch.tolerance = {-0.1 * (k + 1), 0.2};
     ch.points = k == 3 ? 0 : 10 * k;

@@ -37,20 +37,20 @@ InspectionPlan RandomPlan(const TriangleMesh& m) {
   InspectionPlan plan;
   plan.tolerance = {-0.08, 0.12};
   plan.allowed_fraction_outside = 0.2;
-  PlanRegion box{"box", {}, ToleranceBand{-0.05, 0.15}, 0.1};
+  PlanRegion box{"box", {}, ToleranceBand{-0.05, 0.15}, 0.1, {}};
   box.select.box_min_mm = {10, 10, -1};
   box.select.box_max_mm = {60, 45, 1};
-  PlanRegion overlap{"overlap", {}, {}, 0.0};
+  PlanRegion overlap{"overlap", {}, {}, 0.0, {}};
   overlap.select.box_min_mm = {40, 0, -1};
   overlap.select.box_max_mm = {100, 100, 1};
-  PlanRegion picked{"picked", {}, ToleranceBand{-0.2, 0.0}, 0.5};
+  PlanRegion picked{"picked", {}, ToleranceBand{-0.2, 0.0}, 0.5, {}};
   picked.select.kind = RegionSelector::Kind::kTriangles;
   for (uint32_t t = 0; t < m.num_triangles(); t += 7) picked.select.triangles.push_back(t);
   plan.regions = {box, overlap, picked};
-  plan.points = {{"P1", {50, 50, 0}, {}, 2.0, ToleranceBand{-0.01, 0.03}},
-                 {"P2", {10, 90, 0.5}, {}, 3.5, {}},
-                 {"corner", {0, 0, 0}, {}, 3.0, {}},
-                 {"off", {50, 50, 10}, {}, 2.0, {}}};  // no CAD point within 2 mm: unmeasured
+  plan.points = {{"P1", {50, 50, 0}, {}, 2.0, ToleranceBand{-0.01, 0.03}, {}},
+                 {"P2", {10, 90, 0.5}, {}, 3.5, {}, {}},
+                 {"corner", {0, 0, 0}, {}, 3.0, {}, {}},
+                 {"off", {50, 50, 10}, {}, 2.0, {}, {}}};  // no CAD point within 2 mm: unmeasured
   return plan;
 }
 
@@ -234,10 +234,10 @@ TEST(Characteristics, AsymmetricBandEdgesGiveTheRightVerdicts) {
   HandMade h = TwoTriangles({lo, hi, 0.0f, 0.1f}, {below, above, hi, lo});
   InspectionPlan plan;
   plan.tolerance = {-0.05, 0.15};
-  PlanRegion a{"edges", {}, {}, 0.0};
+  PlanRegion a{"edges", {}, {}, 0.0, {}};
   a.select.kind = RegionSelector::Kind::kTriangles;
   a.select.triangles = {0};
-  PlanRegion b{"beyond", {}, {}, 0.5};
+  PlanRegion b{"beyond", {}, {}, 0.5, {}};
   b.select.kind = RegionSelector::Kind::kTriangles;
   b.select.triangles = {1};
   PlanRegion c = b;
@@ -246,9 +246,9 @@ TEST(Characteristics, AsymmetricBandEdgesGiveTheRightVerdicts) {
   plan.regions = {a, b, c};
   // Points: the mean of triangle 0's points (0.05), judged against bands
   // whose upper edge is the value itself and just below it.
-  plan.points = {{"at_edge", {0.7, 0.3, 0}, {}, 0.01, ToleranceBand{-0.01, 0.05}},
-                 {"past_edge", {0.7, 0.3, 0}, {}, 0.01, ToleranceBand{-0.01, 0.0499}},
-                 {"lower_edge", {0.7, 0.3, 0}, {}, 0.01, ToleranceBand{0.05, 0.2}}};
+  plan.points = {{"at_edge", {0.7, 0.3, 0}, {}, 0.01, ToleranceBand{-0.01, 0.05}, {}},
+                 {"past_edge", {0.7, 0.3, 0}, {}, 0.01, ToleranceBand{-0.01, 0.0499}, {}},
+                 {"lower_edge", {0.7, 0.3, 0}, {}, 0.01, ToleranceBand{0.05, 0.2}, {}}};
   auto rp = ResolveInspectionPlan(plan, h.mesh);
   ASSERT_TRUE(rp.ok()) << rp.status();
   auto r = ComputeCharacteristics(h.em, *rp);

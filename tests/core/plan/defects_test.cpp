@@ -352,7 +352,7 @@ TEST(Defects, SameResultForAnyThreadCount) {
 TEST(Defects, NamesTheRegionAndRefusesBadInput) {
   const Synthetic s = MakeSynthetic(true);
   InspectionPlan plan;
-  PlanRegion left{"left", {}, {}, 0.0};
+  PlanRegion left{"left", {}, {}, 0.0, {}};
   left.select.box_min_mm = {0, 0, -1};
   left.select.box_max_mm = {50, 100, 1};
   plan.regions = {left};

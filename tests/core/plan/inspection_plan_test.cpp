@@ -157,7 +157,7 @@ TEST(InspectionPlan, TheValidatorChecksStructsFromAnySource) {
   auto st = ValidateInspectionPlan(plan, m, {}, "ErrorMapRequest.plan");
   EXPECT_EQ(st.message(), "ErrorMapRequest.plan.tolerance_mm: lower (0.2) > upper (0.1)");
   plan.tolerance = {-0.1, 0.1};
-  plan.points.push_back({"P", Eigen::Vector3d(1, 2, NAN), Eigen::Vector3d::Zero(), 2.0, {}});
+  plan.points.push_back({"P", Eigen::Vector3d(1, 2, NAN), Eigen::Vector3d::Zero(), 2.0, {}, {}});
   EXPECT_EQ(ValidateInspectionPlan(plan, m).message(),
             "plan.points[0].position_mm: not a finite number");
   plan.points[0].position_mm.z() = 0;

@@ -11,6 +11,7 @@
 
 #include "core/io/io_mesh.h"
 #include "core/pipeline/inspection_report.h"
+#include "core/plan/surface_neighbourhood.h"
 #include "tests/support/plane_scan.h"
 #include "tests/support/temp_dir.h"
 #include "tests/support/test_meshes.h"
@@ -40,8 +41,12 @@ Scene MakeScene(const ErrorMapSettings& settings = {}) {
   return s;
 }
 
+// The scan covers [5, 44.75]^2 of the [0, 50]^2 square, with the 1 mm
+// coverage distance [3.75, 45.75]^2: ~70% of the surface and of "left", so
+// the plan asks for 60%.
 nlohmann::json PlanJson() {
   return nlohmann::json::parse(R"({
+    "min_coverage": 0.6,
     "regions": [{"name": "left", "select": {"box_mm": [[0, 0, -1], [25, 50, 1]]},
                  "tolerance_mm": {"lower": -0.25, "upper": 0.25}}],
     "points": [{"name": "dent", "position_mm": [20, 20, 0], "radius_mm": 1.0},
@@ -79,7 +84,12 @@ TEST(PlanEvaluation, EqualsTheCoreFunctionsCalledDirectly) {
   ASSERT_TRUE(resolved.ok());
   auto defects = FindDefects(s.error_map, s.cloud, s.mesh, *plan->defects, &*resolved);
   ASSERT_TRUE(defects.ok());
-  auto judged = ComputeCharacteristics(s.error_map, *resolved, defects->defects.size());
+  CoverageSettings cs;
+  cs.distance_mm = kCoverageSpacings * EstimateSurfaceSpacing(s.error_map, s.cloud);
+  auto coverage = ComputeCoverage(s.error_map, s.mesh, *resolved, cs);
+  ASSERT_TRUE(coverage.ok());
+  auto judged =
+      ComputeCharacteristics(s.error_map, *resolved, defects->defects.size(), {}, &*coverage);
   ASSERT_TRUE(judged.ok());
   EXPECT_TRUE(out->defects_run);
   EXPECT_EQ(DefectsJson(out->defects), DefectsJson(*defects));
@@ -94,6 +104,8 @@ TEST(PlanEvaluation, EqualsTheCoreFunctionsCalledDirectly) {
   const auto& c = out->characteristics.characteristics;
   ASSERT_EQ(c.size(), 4u);
   EXPECT_FALSE(c[0].pass);
+  EXPECT_TRUE(c[0].measured);
+  EXPECT_NEAR(c[0].coverage, 41.75 * 41.75 / 2500, 0.005) << "[3.75, 45.75]^2";
   EXPECT_TRUE(c[1].pass) << c[1].reason;
   EXPECT_NEAR(c[2].value_mm, -0.2 * 8 * (1 - std::exp(-1.0 / 8)), 0.005);
   EXPECT_FALSE(c[2].pass);
@@ -156,7 +168,7 @@ TEST(PlanEvaluation, BadPlansNameTheField) {
             absl::StatusCode::kInvalidArgument);
   // A plan that does not fit the mesh is refused by EvaluatePlan too.
   InspectionPlan bad;
-  bad.regions.push_back({"t", {}, {}, 0});
+  bad.regions.push_back({"t", {}, {}, 0, {}});
   bad.regions[0].select.kind = RegionSelector::Kind::kTriangles;
   bad.regions[0].select.triangles = {static_cast<uint32_t>(s.mesh.num_triangles())};
   auto out = EvaluatePlan(s.error_map, s.cloud, s.mesh, bad);
