@@ -365,7 +365,7 @@ grpc::ServerUnaryReactor* InspectionService::ErrorMap(grpc::CallbackServerContex
       return FromCore(st);
     auto map = ComputeErrorMap(*part, *cloud, *world_from_part, *settings, &cancel);
     if (!map.ok()) return FromCore(map.status());
-    auto outcome = EvaluatePlan(*map, *cloud, part->mesh(), *plan, settings->threads);
+    auto outcome = EvaluatePlan(*map, *cloud, part->mesh(), *plan, settings->threads, &cancel);
     if (!outcome.ok()) return FromCore(outcome.status());
     if (IsCancelled(&cancel)) return CancelledBetweenSteps();
     wire::ErrorMapToProto(*map, *settings, *outcome, req->return_deviations(), resp);

@@ -44,7 +44,7 @@ absl::StatusOr<InspectionResult> InspectPart(const MeshIndex& part,
   ASSIGN_OR_RETURN(
       out.plan, EvaluatePlan(out.error_map, out.merged.cloud_in_world, part.mesh(),
                              settings.plan ? *settings.plan : PlanFromSettings(settings.error_map),
-                             settings.error_map.threads));
+                             settings.error_map.threads, cancel));
   if (progress) progress(InspectionStage::kErrorMap, "", out.error_map.stats.matched);
   return out;
 }

@@ -4,15 +4,19 @@
 // Without it a region that the sensor barely saw (a shadow, a missing
 // viewpoint) would be judged, and pass, on a handful of points.
 //
-// The area is sampled exactly: each CAD triangle is cut into n x n congruent
-// sub-triangles (n = ceil(longest edge / sample_mm)), each standing for its
-// area at its centroid, so a fraction is area-weighted. The closest points
-// sit in a hash grid of cells distance_mm wide; a centroid looks at its 27
-// cells. Per triangle, region (ResolvedInspectionPlan's rows) and the whole
+// The area is sampled on a square grid of sample_mm cells in each CAD
+// triangle's plane; the cells whose centres lie inside the triangle stand
+// for equal parts of its area (a triangle smaller than a cell, by its
+// centroid). A sample is covered by the matched closest points on its
+// triangle and on the triangles sharing its edges, so coverage runs across
+// an edge as on the surface (not across a vertex-only neighbour: a
+// scanned area ending exactly at such a corner loses a sliver < distance_mm).
+// Per triangle, region (ResolvedInspectionPlan's rows) and the whole
 // surface; a comparison point's coverage is that of the part of the surface
 // within its radius. Units mm, part frame. Deterministic for any thread count.
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <vector>
 
@@ -25,7 +29,7 @@ namespace surfinspect {
 
 struct CoverageSettings {
   double distance_mm = 1.0;  // a location this close to a measured point is covered; > 0
-  double sample_mm = 0;      // sub-triangle size; 0 = distance_mm / 2
+  double sample_mm = 0;      // sampling cell size; 0 = distance_mm / 2
   int threads = 0;           // 0 = all cores
 };
 
@@ -38,10 +42,12 @@ struct CoverageResult {
 };
 
 // `error_map` was computed against `part`; `plan` was resolved on `part`.
-// InvalidArgument for bad settings or mismatched sizes.
+// InvalidArgument for bad settings or mismatched sizes; Cancelled when
+// `cancel` is raised (polled per block of triangles).
 absl::StatusOr<CoverageResult> ComputeCoverage(const ErrorMapResult& error_map,
                                                const TriangleMesh& part,
                                                const ResolvedInspectionPlan& plan,
-                                               const CoverageSettings& settings);
+                                               const CoverageSettings& settings,
+                                               const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace surfinspect

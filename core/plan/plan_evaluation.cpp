@@ -44,17 +44,30 @@ absl::StatusOr<InspectionPlan> ParsePlanForMeshFile(
                       absl::StrCat(plan.status().message(), " (", groups.status().message(), ")"));
 }
 
+bool PlanJudgesCoverage(const InspectionPlan& plan) {
+  bool any = plan.min_coverage > 0;
+  for (const PlanRegion& r : plan.regions) any |= r.min_coverage.value_or(plan.min_coverage) > 0;
+  for (const ComparisonPoint& p : plan.points)
+    any |= p.min_coverage.value_or(plan.min_coverage) > 0;
+  return any;
+}
+
 absl::StatusOr<PlanOutcome> EvaluatePlan(const ErrorMapResult& error_map, const PointCloud& cloud,
                                          const TriangleMesh& part, const InspectionPlan& plan,
-                                         int threads) {
+                                         int threads, const std::atomic<bool>* cancel) {
   ASSIGN_OR_RETURN(auto resolved, ResolveInspectionPlan(plan, part));
   PlanOutcome out;
-  const double spacing = EstimateSurfaceSpacing(error_map, cloud);
-  CoverageSettings cov;
-  cov.distance_mm =
-      plan.coverage_distance_mm > 0 ? plan.coverage_distance_mm : kCoverageSpacings * spacing;
-  cov.threads = threads;
-  ASSIGN_OR_RETURN(out.coverage, ComputeCoverage(error_map, part, resolved, cov));
+  // The sampling spacing, estimated once for coverage and defects alike.
+  const bool coverage = PlanJudgesCoverage(plan);
+  const double spacing = coverage || plan.defects ? EstimateSurfaceSpacing(error_map, cloud) : 0.0;
+  if (coverage) {
+    CoverageSettings cov;
+    cov.distance_mm =
+        plan.coverage_distance_mm > 0 ? plan.coverage_distance_mm : kCoverageSpacings * spacing;
+    cov.threads = threads;
+    ASSIGN_OR_RETURN(out.coverage, ComputeCoverage(error_map, part, resolved, cov, cancel));
+    out.coverage_run = true;
+  }
   if (plan.defects) {
     DefectSettings ds;
     ds.spacing_mm = spacing;
@@ -65,9 +78,9 @@ absl::StatusOr<PlanOutcome> EvaluatePlan(const ErrorMapResult& error_map, const 
   }
   CharacteristicsSettings cs;
   cs.threads = threads;
-  ASSIGN_OR_RETURN(
-      out.characteristics,
-      ComputeCharacteristics(error_map, resolved, out.defects.defects.size(), cs, &out.coverage));
+  ASSIGN_OR_RETURN(out.characteristics,
+                   ComputeCharacteristics(error_map, resolved, out.defects.defects.size(), cs,
+                                          out.coverage_run ? &out.coverage : nullptr));
   return out;
 }
 

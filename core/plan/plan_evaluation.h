@@ -60,17 +60,24 @@ inline constexpr double kCoverageSpacings = 4.0;
 
 struct PlanOutcome {
   CharacteristicsResult characteristics;  // surface, regions, points
-  CoverageResult coverage;                // of the same characteristics
+  bool coverage_run = false;              // PlanJudgesCoverage
+  CoverageResult coverage;                // of the same characteristics, when run
   bool defects_run = false;               // the plan has defect rules
   DefectsResult defects;                  // empty unless defects_run
   bool pass() const { return characteristics.pass; }
 };
 
+// Whether any characteristic of the plan needs a least coverage; only then
+// is coverage computed (a plan of min_coverage 0, and the plan of a caller
+// without one, judge whatever was seen, as before coverage existed).
+bool PlanJudgesCoverage(const InspectionPlan& plan);
+
 // `cloud` is the cloud `error_map` was computed on (any frame), `part` the
 // mesh it was computed against. InvalidArgument (field named, "plan...")
-// for a plan that does not fit the part.
+// for a plan that does not fit the part; Cancelled when `cancel` is raised.
 absl::StatusOr<PlanOutcome> EvaluatePlan(const ErrorMapResult& error_map, const PointCloud& cloud,
                                          const TriangleMesh& part, const InspectionPlan& plan,
-                                         int threads = 0);
+                                         int threads = 0,
+                                         const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace surfinspect
