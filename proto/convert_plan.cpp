@@ -52,6 +52,12 @@ absl::StatusOr<ComparisonPoint> PointFromProto(const v1::ComparisonPoint& msg,
       return Invalid(field + ".normal", "must be a finite non-zero vector");
     p.normal = n.normalized();
   }
+  if (msg.direction_size() != 0) {
+    ASSIGN_OR_RETURN(auto a, Vector3FromProto(msg.direction(), field + ".direction"));
+    if (!(a.norm() > 0) || !a.allFinite())
+      return Invalid(field + ".direction", "must be a finite non-zero vector");
+    p.direction = a.normalized();
+  }
   if (msg.has_radius_mm()) p.radius_mm = msg.radius_mm();
   if (msg.has_tolerance_mm()) p.tolerance = BandFromProto(msg.tolerance_mm());
   if (msg.has_min_coverage()) p.min_coverage = msg.min_coverage();
@@ -124,6 +130,7 @@ void PlanToProto(const InspectionPlan& plan, v1::InspectionPlan* msg) {
     m->set_name(p.name);
     Vector3ToProto(p.position_mm, m->mutable_position_mm());
     if (p.normal != Eigen::Vector3d::Zero()) Vector3ToProto(p.normal, m->mutable_normal());
+    if (p.direction != Eigen::Vector3d::Zero()) Vector3ToProto(p.direction, m->mutable_direction());
     m->set_radius_mm(p.radius_mm);
     if (p.tolerance) BandToProto(*p.tolerance, m->mutable_tolerance_mm());
     if (p.min_coverage) m->set_min_coverage(*p.min_coverage);

@@ -1,6 +1,4 @@
-#include "core/pipeline/inspection_report.h"
-
-#include "core/types/json_fields.h"
+#include "core/pipeline/inspection_report.h"  // and core/types/json_fields.h
 
 namespace surfinspect {
 namespace {

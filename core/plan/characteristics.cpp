@@ -83,10 +83,10 @@ void AccumulateChunk(const ErrorMapResult& em, const ResolvedInspectionPlan& rp,
     for (uint32_t k = rp.point_offsets[t]; k < rp.point_offsets[t + 1]; ++k) {
       const uint32_t p = rp.point_ids[k];
       const Eigen::Vector3d q = em.closest_point[i].cast<double>();
-      if ((q - rp.plan.points[p].position_mm).squaredNorm() <= radius_sq[p]) {
-        const std::size_t c = point_base + p;
-        acc[c].Add(d, bands[c]);
-      }
+      if ((q - rp.plan.points[p].position_mm).squaredNorm() > radius_sq[p]) continue;
+      const float v = rp.point_scale.empty() ? d : d * rp.point_scale[k];  // along its direction
+      const std::size_t c = point_base + p;
+      if (!std::isnan(v)) acc[c].Add(v, bands[c]);
     }
   }
   acc[0] = surface;
@@ -121,10 +121,12 @@ void JudgeArea(CharacteristicResult& c) {
       c.above, c.below, 100 * c.allowed_fraction_outside);
 }
 
-void JudgePoint(double radius_mm, CharacteristicResult& c) {
+void JudgePoint(const ComparisonPoint& p, CharacteristicResult& c) {
+  const bool directional = p.direction != Eigen::Vector3d::Zero();
   if (c.points == 0) {
     c.pass = false;
-    c.reason = absl::StrFormat("fail: unmeasured (no measured point within %.4g mm)", radius_mm);
+    c.reason = absl::StrFormat("fail: unmeasured (no measured point within %.4g mm%s)", p.radius_mm,
+                               directional ? " on a face the direction can meet" : "");
     return;
   }
   c.value_mm = c.mean_mm;
@@ -135,6 +137,9 @@ void JudgePoint(double radius_mm, CharacteristicResult& c) {
       absl::StrFormat("%s: value %.4f mm (mean of %u points) %s [%.4g, %.4g] mm",
                       c.pass ? "pass" : "fail", c.value_mm, c.points, c.pass ? "inside" : "outside",
                       c.tolerance.lower_mm, c.tolerance.upper_mm);
+  if (directional)
+    absl::StrAppend(&c.reason, absl::StrFormat(" along (%.4g, %.4g, %.4g)", p.direction.x(),
+                                               p.direction.y(), p.direction.z()));
 }
 
 // Not measured when its area was seen over less than it needs.
@@ -182,7 +187,7 @@ CharacteristicResult Judge(const ErrorMapResult& em, const ResolvedInspectionPla
     const ComparisonPoint& p = plan.points[i];
     c.name = p.name;
     c.type = CharacteristicType::kPoint;
-    JudgePoint(p.radius_mm, c);
+    JudgePoint(p, c);
     if (coverage) JudgeCoverage(coverage->points[i], p.min_coverage.value_or(plan.min_coverage), c);
   }
   return c;

@@ -229,7 +229,12 @@ struct TriangleSums {
 void SampleTriangle(const TriangleMesh& part, const ResolvedInspectionPlan& rp,
                     const Rows<Eigen::Vector3f>& points, const Rows<uint32_t>& neighbours,
                     const CoverageSettings& s, uint32_t t, TriangleSums& out) {
-  TriangleRaster raster(part, t, s.sample_mm, s.distance_mm);
+  // A comparison point's disc gets samples however small it is: its
+  // triangles are sampled at a third of the smallest radius reaching them.
+  double cell = s.sample_mm;
+  for (uint32_t k = rp.point_offsets[t]; k < rp.point_offsets[t + 1]; ++k)
+    cell = std::min(cell, rp.plan.points[rp.point_ids[k]].radius_mm / 3);
+  TriangleRaster raster(part, t, cell, s.distance_mm);
   std::vector<TriangleRaster::Located> located;
   TriangleRaster::Located l;
   const auto locate = [&](uint32_t tri) {

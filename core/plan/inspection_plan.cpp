@@ -103,6 +103,24 @@ void BuildRows(std::size_t rows, std::size_t ids, F member, std::vector<uint32_t
   }
 }
 
+// ResolvedInspectionPlan::point_scale.
+std::vector<float> DirectionScales(const ResolvedInspectionPlan& r, const TriangleMesh& part) {
+  constexpr double kMinCosine = 0.1736;  // cos 80 degrees
+  bool any = false;
+  for (const ComparisonPoint& p : r.plan.points) any |= p.direction != Eigen::Vector3d::Zero();
+  if (!any) return {};
+  const std::vector<Eigen::Vector3f> normals = part.FaceNormals();
+  std::vector<float> scale(r.point_ids.size(), 1.f);
+  for (std::size_t t = 0; t < r.num_triangles; ++t)
+    for (uint32_t k = r.point_offsets[t]; k < r.point_offsets[t + 1]; ++k) {
+      const Eigen::Vector3d& a = r.plan.points[r.point_ids[k]].direction;
+      if (a == Eigen::Vector3d::Zero()) continue;
+      const double c = normals[t].cast<double>().dot(a);
+      scale[k] = std::abs(c) >= kMinCosine ? static_cast<float>(1 / c) : NAN;
+    }
+  return scale;
+}
+
 }  // namespace
 
 absl::Status ValidateInspectionPlan(const InspectionPlan& plan, const TriangleMesh& part,
@@ -136,6 +154,7 @@ absl::Status ValidateInspectionPlan(const InspectionPlan& plan, const TriangleMe
     RETURN_IF_ERROR(CheckName(path + ".name", p.name, names));
     if (!p.position_mm.allFinite()) return Bad(path + ".position_mm", "not a finite number");
     if (!p.normal.allFinite()) return Bad(path + ".normal", "not a finite number");
+    if (!p.direction.allFinite()) return Bad(path + ".direction", "not a finite number");
     RETURN_IF_ERROR(CheckFinite(path + ".radius_mm", p.radius_mm));
     if (!(p.radius_mm > 0)) return Bad(path + ".radius_mm", "must be > 0");
     if (p.tolerance) RETURN_IF_ERROR(CheckBand(path + ".tolerance_mm", *p.tolerance));
@@ -203,6 +222,7 @@ absl::StatusOr<ResolvedInspectionPlan> ResolveInspectionPlan(const InspectionPla
                p.radius_mm * p.radius_mm;
       },
       r.point_offsets, r.point_ids);
+  r.point_scale = DirectionScales(r, part);
   return r;
 }
 

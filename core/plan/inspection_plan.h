@@ -75,6 +75,11 @@ struct ComparisonPoint {
   double radius_mm = 2.0;  // > 0
   std::optional<ToleranceBand> tolerance;
   std::optional<double> min_coverage;  // of the surface within radius_mm; unset: the plan's
+  // A directional point (e.g. the stamping direction; unit after parsing):
+  // its value is the deviation measured along this direction, d / (n . a)
+  // for a point of normal deviation d on a CAD face of normal n, instead of
+  // along the normal. Zero: along the normal.
+  Eigen::Vector3d direction = Eigen::Vector3d::Zero();
 };
 
 struct DefectRules {
@@ -135,6 +140,11 @@ struct ResolvedInspectionPlan {
   // Comparison points triangle t can reach, likewise.
   std::vector<uint32_t> point_offsets;
   std::vector<uint32_t> point_ids;
+  // Per entry of point_ids: the factor from a normal deviation on that
+  // triangle to the point's value, 1 / (n . direction); NaN where the
+  // direction is within 10 degrees of the face (the surface cannot be met
+  // along it). Empty when no point has a direction (every factor 1).
+  std::vector<float> point_scale;
   std::vector<std::size_t> region_triangle_count;  // per region
 
   // The first region (plan order) containing triangle t, or -1.

@@ -139,8 +139,9 @@ absl::StatusOr<PlanRegion> Region(const json& j, const std::string& path) {
 }
 
 absl::StatusOr<ComparisonPoint> Point(const json& j, const std::string& path) {
-  if (auto st = CheckKeys(
-          j, path, {"name", "position_mm", "normal", "radius_mm", "tolerance_mm", "min_coverage"});
+  if (auto st = CheckKeys(j, path,
+                          {"name", "position_mm", "normal", "direction", "radius_mm",
+                           "tolerance_mm", "min_coverage"});
       !st.ok())
     return st;
   ComparisonPoint p;
@@ -154,6 +155,11 @@ absl::StatusOr<ComparisonPoint> Point(const json& j, const std::string& path) {
     ASSIGN_OR_RETURN(auto n, Vector3(j["normal"], path + ".normal"));
     if (!(n.norm() > 1e-12)) return Bad(path + ".normal", "zero vector");
     p.normal = n.normalized();
+  }
+  if (j.contains("direction")) {
+    ASSIGN_OR_RETURN(auto a, Vector3(j["direction"], path + ".direction"));
+    if (!(a.norm() > 1e-12)) return Bad(path + ".direction", "zero vector");
+    p.direction = a.normalized();
   }
   if (j.contains("radius_mm")) {
     ASSIGN_OR_RETURN(auto r, Number(j["radius_mm"], path + ".radius_mm"));

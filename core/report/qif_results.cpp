@@ -78,8 +78,8 @@ absl::StatusOr<Characteristic> ReadCharacteristic(const ReportCharacteristic& c,
     return absl::InvalidArgumentError(absl::StrCat(where, ".tolerance_mm: missing"));
   if (out.type != "surface" && out.type != "region" && out.type != "point")
     return absl::InvalidArgumentError(absl::StrCat(where, ".type: unknown \"", out.type, "\""));
-  if (out.verdict != "pass" && out.verdict != "fail")
-    return absl::InvalidArgumentError(absl::StrCat(where, ".verdict: not pass/fail"));
+  if (out.verdict != "pass" && out.verdict != "fail" && out.verdict != "not_measured")
+    return absl::InvalidArgumentError(absl::StrCat(where, ".verdict: not pass/fail/not_measured"));
   return out;
 }
 
@@ -97,6 +97,13 @@ std::string ModelOf(const QifContext& ctx) {
 }
 
 const char* Upper(const std::string& verdict) { return verdict == "pass" ? "PASS" : "FAIL"; }
+
+// A characteristic's status; QIF's CharacteristicStatusEnum has no "not
+// measured", and INDETERMINATE is what a characteristic seen over too little
+// of its area is (Characteristics.xsd).
+const char* CharacteristicStatus(const std::string& verdict) {
+  return verdict == "not_measured" ? "INDETERMINATE" : Upper(verdict);
+}
 
 void AddPreamble(pugi::xml_node doc, const QifContext& ctx) {
   Text(doc, "QPId", QifUuid(absl::StrCat("document/", ctx.cell, "/", ctx.part_id)));
@@ -156,7 +163,7 @@ void AddMeasurement(pugi::xml_node list, const Characteristic& c, int id) {
   pugi::xml_node m =
       WithId(list, (std::string(c.qif_kind()) + "CharacteristicMeasurement").c_str(), id + 3);
   if (!c.reason.empty()) Text(m, "Description", c.reason);
-  Text(m.append_child("Status"), "CharacteristicStatusEnum", Upper(c.verdict));
+  Text(m.append_child("Status"), "CharacteristicStatusEnum", CharacteristicStatus(c.verdict));
   Text(m, "CharacteristicItemId", std::to_string(id + 2));
   Text(m, "ActualComponentId", std::to_string(kComponentId));
   Text(Counted(m, "MeasurementDeviceIds", 1), "Id", std::to_string(kDeviceId));

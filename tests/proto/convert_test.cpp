@@ -254,6 +254,7 @@ TEST(PlanProto, RoundTripsEveryFieldAndUnsetBandsTakeTheSettings) {
   plan.regions = {box, tris, group};
   plan.points = {{"P1", {1, 2, 3}, {0, 0, 1}, 2.5, ToleranceBand{-0.1, 0.3}, 0.4},
                  {"P2", {4, 5, 6}, {}, 2.0, {}, {}}};
+  plan.points[0].direction = {0, 0.6, 0.8};
   plan.defects = DefectRules{0.03, 4.0, 2};
   v1::InspectionPlan msg;
   PlanToProto(plan, &msg);
@@ -273,6 +274,8 @@ TEST(PlanProto, RoundTripsEveryFieldAndUnsetBandsTakeTheSettings) {
   EXPECT_EQ(*back->regions[0].min_coverage, 0.6);
   EXPECT_FALSE(back->regions[1].min_coverage.has_value());
   EXPECT_EQ(*back->points[0].min_coverage, 0.4);
+  EXPECT_EQ(back->points[0].direction, Eigen::Vector3d(0, 0.6, 0.8));
+  EXPECT_EQ(back->points[1].direction, Eigen::Vector3d::Zero());
   // An empty message: the surface against +-tolerance_mm, no defects.
   ErrorMapSettings s;
   s.tolerance_mm = 0.3;

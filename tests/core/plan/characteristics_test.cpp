@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstring>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <random>
 
 #include "tests/support/test_meshes.h"
@@ -291,6 +292,57 @@ TEST(Characteristics, DefectsFailThePartOnlyWithMaxCount) {
   auto zero = ComputeCharacteristics(h.em, *rp, 1);
   EXPECT_FALSE(zero->pass);
   EXPECT_NE(zero->reason.find("1 defects (at most 0 allowed)"), std::string::npos) << zero->reason;
+}
+
+// Directional points on the slope z = 0.5 x, scanned 0.2 mm too high
+// (every point shifted along +z): the normal deviation is 0.2 cos(atan 0.5)
+// = 0.1789 mm; along the stamping direction +z it is the 0.2 mm shift;
+// along +x the surface is met 0.4 mm behind (0.5 (x + t) + 0.2 = 0.5 x);
+// a direction in the face's plane cannot meet it and gives no value.
+TEST(Characteristics, ADirectionalPointMeasuresAlongItsDirection) {
+  const TriangleMesh mesh =
+      testing::HeightField(0, 40, 0, 40, 5, 5, [](double x, double) { return 0.5 * x; });
+  std::vector<Eigen::Vector3f> points;
+  for (int i = 0; i <= 160; ++i)
+    for (int j = 0; j <= 160; ++j) {
+      const double x = 0.25 * i, y = 0.25 * j;
+      points.emplace_back(x, y, 0.5 * x + 0.2);
+    }
+  auto index = MeshIndex::Build(mesh);
+  ASSERT_TRUE(index.ok());
+  auto em =
+      ComputeErrorMap(**index, PointCloud::Unorganized(points), Eigen::Isometry3d::Identity(), {});
+  ASSERT_TRUE(em.ok());
+  InspectionPlan plan;
+  plan.tolerance = {-1, 1};
+  const Eigen::Vector3d at(20, 20, 10);
+  ComparisonPoint normal{"normal", at, Eigen::Vector3d::Zero(), 2.0, {}, {}};
+  ComparisonPoint up = normal, along_x = normal, in_plane = normal;
+  up.name = "up";
+  up.direction = Eigen::Vector3d::UnitZ();
+  along_x.name = "along_x";
+  along_x.direction = Eigen::Vector3d::UnitX();
+  in_plane.name = "in_plane";
+  in_plane.direction = Eigen::Vector3d(2, 0, 1).normalized();
+  plan.points = {normal, up, along_x, in_plane};
+  auto rp = ResolveInspectionPlan(plan, mesh);
+  ASSERT_TRUE(rp.ok()) << rp.status();
+  auto r = ComputeCharacteristics(*em, *rp);
+  ASSERT_TRUE(r.ok());
+  const auto& c = r->characteristics;
+  EXPECT_NEAR(c[1].value_mm, 0.2 / std::sqrt(1.25), 1e-5);
+  EXPECT_NEAR(c[2].value_mm, 0.2, 1e-5);
+  EXPECT_NEAR(c[3].value_mm, -0.4, 1e-5);
+  EXPECT_NE(c[2].reason.find("along (0, 0, 1)"), std::string::npos) << c[2].reason;
+  EXPECT_EQ(c[4].points, 0u);
+  EXPECT_FALSE(c[4].pass);
+  EXPECT_NE(c[4].reason.find("the direction can meet"), std::string::npos) << c[4].reason;
+  // The JSON form: a zero direction is refused, naming the field.
+  auto bad = ParseInspectionPlan(
+      nlohmann::json::parse(R"({"points": [{"name": "P", "position_mm": [20, 20, 10],
+                                            "direction": [0, 0, 0]}]})"),
+      mesh);
+  EXPECT_EQ(bad.status().message(), "plan.points[0].direction: zero vector");
 }
 
 TEST(Characteristics, RefusesAMapFromAnotherMesh) {

@@ -153,6 +153,15 @@ TEST(Coverage, AComparisonPointCountsTheSurfaceWithinItsRadius) {
   EXPECT_GT(got->points[1], 0.3);  // half its disc lies outside the hole
   EXPECT_LT(got->points[1], 0.7);
   EXPECT_GT(got->points[2], 0.97);
+  // A disc smaller than the sampling cells still has samples.
+  plan.points = {seen};
+  plan.points[0].radius_mm = 0.3;
+  rp = ResolveInspectionPlan(plan, s.mesh);
+  ASSERT_TRUE(rp.ok());
+  cs.distance_mm = 4;  // cells of 2 mm
+  got = ComputeCoverage(s.em, s.mesh, *rp, cs);
+  ASSERT_TRUE(got.ok());
+  EXPECT_EQ(got->points[0], 1.0);
 }
 
 TEST(Coverage, ARegionWhosePointsWereRemovedIsNotMeasured) {
