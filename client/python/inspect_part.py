@@ -72,7 +72,9 @@ def main():
     print(f"{part_id} {verdict}  min {result.statistics.min_mm:+.3f} mm"
           f"  max {result.statistics.max_mm:+.3f} mm")
     for c in result.characteristics:
-        if c.verdict != sc.pb.VERDICT_PASS:
+        if c.verdict == sc.pb.VERDICT_NOT_MEASURED:
+            print(f"  not measured {c.name}: {c.reason}")
+        elif c.verdict != sc.pb.VERDICT_PASS:
             print(f"  failed {c.name}: {c.reason}")
     for d in result.defects:
         kind = "dent" if d.kind == sc.pb.DEFECT_DENT else "bump"
