@@ -64,6 +64,22 @@ absl::StatusOr<ComparisonPoint> PointFromProto(const v1::ComparisonPoint& msg,
   return p;
 }
 
+absl::StatusOr<PlanSection> SectionFromProto(const v1::PlanSection& msg, const std::string& field) {
+  PlanSection s;
+  s.name = msg.name();
+  ASSIGN_OR_RETURN(s.point_mm, Vector3FromProto(msg.point_mm(), field + ".point_mm"));
+  ASSIGN_OR_RETURN(auto n, Vector3FromProto(msg.normal(), field + ".normal"));
+  if (!(n.norm() > 0) || !n.allFinite())
+    return Invalid(field + ".normal", "must be a finite non-zero vector");
+  s.normal = n.normalized();
+  if (msg.has_width_mm()) s.width_mm = msg.width_mm();
+  s.region = msg.region();
+  if (msg.has_tolerance_mm()) s.tolerance = BandFromProto(msg.tolerance_mm());
+  if (msg.has_allowed_fraction_outside())
+    s.allowed_fraction_outside = msg.allowed_fraction_outside();
+  return s;
+}
+
 }  // namespace
 
 absl::StatusOr<InspectionPlan> PlanFromProto(const v1::InspectionPlan& msg,
@@ -85,6 +101,11 @@ absl::StatusOr<InspectionPlan> PlanFromProto(const v1::InspectionPlan& msg,
     ASSIGN_OR_RETURN(auto p,
                      PointFromProto(msg.points(i), absl::StrCat(field, ".points[", i, "]")));
     plan.points.push_back(std::move(p));
+  }
+  for (int i = 0; i < msg.sections_size(); ++i) {
+    ASSIGN_OR_RETURN(auto s,
+                     SectionFromProto(msg.sections(i), absl::StrCat(field, ".sections[", i, "]")));
+    plan.sections.push_back(std::move(s));
   }
   if (msg.has_defects()) {
     DefectRules d;
@@ -134,6 +155,16 @@ void PlanToProto(const InspectionPlan& plan, v1::InspectionPlan* msg) {
     m->set_radius_mm(p.radius_mm);
     if (p.tolerance) BandToProto(*p.tolerance, m->mutable_tolerance_mm());
     if (p.min_coverage) m->set_min_coverage(*p.min_coverage);
+  }
+  for (const PlanSection& s : plan.sections) {
+    v1::PlanSection* m = msg->add_sections();
+    m->set_name(s.name);
+    Vector3ToProto(s.point_mm, m->mutable_point_mm());
+    Vector3ToProto(s.normal, m->mutable_normal());
+    m->set_width_mm(s.width_mm);
+    m->set_region(s.region);
+    if (s.tolerance) BandToProto(*s.tolerance, m->mutable_tolerance_mm());
+    m->set_allowed_fraction_outside(s.allowed_fraction_outside);
   }
   if (plan.defects) {
     v1::DefectRules* d = msg->mutable_defects();

@@ -89,6 +89,8 @@ v1::CharacteristicType TypeToProto(CharacteristicType t) {
       return v1::CHARACTERISTIC_REGION;
     case CharacteristicType::kPoint:
       return v1::CHARACTERISTIC_POINT;
+    case CharacteristicType::kSection:
+      return v1::CHARACTERISTIC_SECTION;
   }
   return v1::CHARACTERISTIC_TYPE_UNSPECIFIED;
 }
@@ -148,9 +150,10 @@ CharacteristicsResult CharacteristicsFromProto(
   for (const v1::CharacteristicResult& m : list) {
     CharacteristicResult c;
     c.name = m.name();
-    c.type = m.type() == v1::CHARACTERISTIC_REGION  ? CharacteristicType::kRegion
-             : m.type() == v1::CHARACTERISTIC_POINT ? CharacteristicType::kPoint
-                                                    : CharacteristicType::kSurface;
+    c.type = m.type() == v1::CHARACTERISTIC_REGION    ? CharacteristicType::kRegion
+             : m.type() == v1::CHARACTERISTIC_POINT   ? CharacteristicType::kPoint
+             : m.type() == v1::CHARACTERISTIC_SECTION ? CharacteristicType::kSection
+                                                      : CharacteristicType::kSurface;
     c.pass = m.verdict() == v1::VERDICT_PASS;
     c.measured = m.verdict() != v1::VERDICT_NOT_MEASURED;
     c.coverage = m.coverage();

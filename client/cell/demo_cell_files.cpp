@@ -96,7 +96,8 @@ double RidgeTopZ(const TriangleMesh& part, double x) {
 
 // plan.json (docs/inspection-plan.md): the top ridge, where the parts are
 // judged, as a region with a tighter band than the cell's +-0.3 mm; three
-// comparison points along it; defect detection with the threshold chosen
+// comparison points along it; a section across it at x = 0 (a 1 mm slab,
+// the ridge's band); defect detection with the threshold chosen
 // for the scans' noise (sigma 0.015 mm: 0.03 mm is ~7 sigma of the local
 // median). The surface keeps the cell's tolerance_mm.
 nlohmann::json PlanJson(const DemoCell& cell) {
@@ -118,6 +119,14 @@ nlohmann::json PlanJson(const DemoCell& cell) {
          {"tolerance_mm", {{"lower", -0.15}, {"upper", 0.15}}},
          {"allowed_fraction_outside", 0.001}}}},
       {"points", points},
+      {"sections",
+       {{{"name", "ridge-x0"},
+         {"point_mm", {0.0, 0.0, 0.0}},
+         {"normal", {1, 0, 0}},
+         {"width_mm", 1.0},
+         {"region", "ridge"},
+         {"tolerance_mm", {{"lower", -0.15}, {"upper", 0.15}}},
+         {"allowed_fraction_outside", 0.001}}}},
       {"defects", {{"threshold_mm", 0.03}, {"min_area_mm2", 3.0}}}};
 }
 

@@ -195,6 +195,25 @@ CharacteristicResult Judge(const ErrorMapResult& em, const ResolvedInspectionPla
 
 }  // namespace
 
+namespace {
+
+// A section judged like a region on the points its cut selected.
+CharacteristicResult JudgeSection(const ErrorMapResult& em, const InspectionPlan& plan,
+                                  const PlanSection& s, const SectionCut& cut) {
+  CharacteristicResult c;
+  c.name = s.name;
+  c.type = CharacteristicType::kSection;
+  c.tolerance = s.tolerance.value_or(plan.tolerance);
+  c.allowed_fraction_outside = s.allowed_fraction_outside;
+  Accumulator a;
+  for (uint32_t i : cut.points) a.Add(em.deviation_mm[i], c.tolerance);
+  FillStats(a, c);
+  JudgeArea(c);
+  return c;
+}
+
+}  // namespace
+
 const char* VerdictName(const CharacteristicResult& c) {
   return c.pass ? "pass" : c.measured ? "fail" : "not_measured";
 }
@@ -207,14 +226,19 @@ const char* CharacteristicTypeName(CharacteristicType type) {
       return "region";
     case CharacteristicType::kPoint:
       return "point";
+    case CharacteristicType::kSection:
+      return "section";
   }
   return "surface";
 }
 
 absl::StatusOr<CharacteristicsResult> ComputeCharacteristics(
     const ErrorMapResult& em, const ResolvedInspectionPlan& rp, std::size_t defect_count,
-    const CharacteristicsSettings& settings, const CoverageResult* coverage) {
+    const CharacteristicsSettings& settings, const CoverageResult* coverage,
+    const std::vector<SectionCut>& sections) {
   const std::size_t n = em.deviation_mm.size();
+  if (sections.size() != rp.plan.sections.size())
+    return absl::InvalidArgumentError("characteristics: one cut per section of the plan");
   if (coverage && (coverage->regions.size() != rp.plan.regions.size() ||
                    coverage->points.size() != rp.plan.points.size()))
     return absl::InvalidArgumentError("characteristics: the coverage is of another plan");
@@ -248,6 +272,11 @@ absl::StatusOr<CharacteristicsResult> ComputeCharacteristics(
     CharacteristicResult c = Judge(em, rp, bands[k], total[k], k, coverage);
     out.failed += !c.pass && c.measured;
     out.not_measured += !c.measured;
+    out.characteristics.push_back(std::move(c));
+  }
+  for (std::size_t s = 0; s < sections.size(); ++s) {
+    CharacteristicResult c = JudgeSection(em, rp.plan, rp.plan.sections[s], sections[s]);
+    out.failed += !c.pass;
     out.characteristics.push_back(std::move(c));
   }
   const bool too_many_defects =

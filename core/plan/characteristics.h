@@ -7,8 +7,9 @@
 //  * A comparison point's value is the mean signed deviation of the scanned
 //    points whose closest CAD point lies within radius_mm of position_mm; it
 //    has no value (failing) when there is none.
-//  * A surface or region passes when it has matched points and the fraction
-//    outside its band is at most allowed_fraction_outside; a point passes
+//  * A surface, region or section passes when it has matched points and
+//    the fraction outside its band is at most allowed_fraction_outside
+//    (a section's points are those CutSection selected); a point passes
 //    when it has a value and that value is inside its band.
 //  * With a coverage (core/plan/coverage.h), a characteristic whose CAD
 //    area was seen over less than its min_coverage is not measured: it
@@ -32,11 +33,13 @@
 #include "core/errormap/error_map.h"
 #include "core/plan/coverage.h"
 #include "core/plan/inspection_plan.h"
+#include "core/plan/section.h"
 
 namespace surfinspect {
 
-enum class CharacteristicType { kSurface, kRegion, kPoint };
-const char* CharacteristicTypeName(CharacteristicType type);  // "surface" | "region" | "point"
+enum class CharacteristicType { kSurface, kRegion, kPoint, kSection };
+// "surface" | "region" | "point" | "section"
+const char* CharacteristicTypeName(CharacteristicType type);
 
 struct CharacteristicResult {
   std::string name;
@@ -74,10 +77,12 @@ const char* VerdictName(const CharacteristicResult& c);
 // `error_map` must come from the part mesh `plan` was resolved against
 // (triangle ids below plan.num_triangles); InvalidArgument otherwise.
 // `defect_count` feeds the max_count rule; pass 0 when defects were not run.
-// `coverage` (of the same plan and map) is judged when given.
+// `coverage` (of the same plan and map) is judged when given. `sections`
+// holds the plan's sections cut on the same map (CutSection), one per
+// plan.sections entry; each is judged like a region on its points.
 absl::StatusOr<CharacteristicsResult> ComputeCharacteristics(
     const ErrorMapResult& error_map, const ResolvedInspectionPlan& plan,
     std::size_t defect_count = 0, const CharacteristicsSettings& settings = {},
-    const CoverageResult* coverage = nullptr);
+    const CoverageResult* coverage = nullptr, const std::vector<SectionCut>& sections = {});
 
 }  // namespace surfinspect

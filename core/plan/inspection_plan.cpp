@@ -121,6 +121,34 @@ std::vector<float> DirectionScales(const ResolvedInspectionPlan& r, const Triang
   return scale;
 }
 
+// Each section: a name, a finite plane that crosses the part (vertices on
+// both sides), a width > 0, an existing region, a band and a fraction.
+absl::Status CheckSections(const InspectionPlan& plan, const TriangleMesh& part,
+                           const std::string& where, std::set<std::string>& names) {
+  for (std::size_t i = 0; i < plan.sections.size(); ++i) {
+    const PlanSection& s = plan.sections[i];
+    const std::string path = Index(where + ".sections", i);
+    RETURN_IF_ERROR(CheckName(path + ".name", s.name, names));
+    if (!s.point_mm.allFinite()) return Bad(path + ".point_mm", "not a finite number");
+    if (!s.normal.allFinite() || !(s.normal.norm() > 0))
+      return Bad(path + ".normal", "must be a finite non-zero vector");
+    RETURN_IF_ERROR(CheckFinite(path + ".width_mm", s.width_mm));
+    if (!(s.width_mm > 0)) return Bad(path + ".width_mm", "must be > 0");
+    double lo = INFINITY, hi = -INFINITY;
+    for (const Eigen::Vector3f& v : part.vertices) {
+      const double d = (v.cast<double>() - s.point_mm).dot(s.normal.normalized());
+      lo = std::min(lo, d), hi = std::max(hi, d);
+    }
+    if (!(lo <= 0 && hi >= 0)) return Bad(path, "the plane misses the part");
+    bool known = s.region.empty();
+    for (const PlanRegion& r : plan.regions) known |= r.name == s.region;
+    if (!known) return Bad(path + ".region", absl::StrCat("no region \"", s.region, "\""));
+    if (s.tolerance) RETURN_IF_ERROR(CheckBand(path + ".tolerance_mm", *s.tolerance));
+    RETURN_IF_ERROR(CheckFraction(path + ".allowed_fraction_outside", s.allowed_fraction_outside));
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
 
 absl::Status ValidateInspectionPlan(const InspectionPlan& plan, const TriangleMesh& part,
@@ -160,6 +188,7 @@ absl::Status ValidateInspectionPlan(const InspectionPlan& plan, const TriangleMe
     if (p.tolerance) RETURN_IF_ERROR(CheckBand(path + ".tolerance_mm", *p.tolerance));
     if (p.min_coverage) RETURN_IF_ERROR(CheckFraction(path + ".min_coverage", *p.min_coverage));
   }
+  RETURN_IF_ERROR(CheckSections(plan, part, where, names));
   if (plan.defects) {
     const std::string path = where + ".defects";
     const DefectRules& d = *plan.defects;

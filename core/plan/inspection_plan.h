@@ -82,6 +82,19 @@ struct ComparisonPoint {
   Eigen::Vector3d direction = Eigen::Vector3d::Zero();
 };
 
+// A section through the part (core/plan/section.h): judged on the matched
+// points whose closest CAD point lies within +-width_mm/2 of the plane, like
+// a region; limited to a region of this plan when `region` names one.
+struct PlanSection {
+  std::string name;
+  Eigen::Vector3d point_mm = Eigen::Vector3d::Zero();  // on the plane, part frame
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();   // unit after parsing
+  double width_mm = 1.0;                               // > 0
+  std::string region;                                  // "" = the whole part
+  std::optional<ToleranceBand> tolerance;              // unset: the plan's band
+  double allowed_fraction_outside = 0.0;               // in [0, 1]
+};
+
 struct DefectRules {
   double threshold_mm = 0.05;  // |robust local deviation| above this is defective; > 0
   double min_area_mm2 = 3.0;   // smaller patches are not reported; >= 0
@@ -108,6 +121,7 @@ struct InspectionPlan {
   bool allow_not_measured = false;
   std::vector<PlanRegion> regions;
   std::vector<ComparisonPoint> points;
+  std::vector<PlanSection> sections;
   std::optional<DefectRules> defects;  // unset: no defect detection
 };
 

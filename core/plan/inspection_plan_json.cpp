@@ -173,6 +173,32 @@ absl::StatusOr<ComparisonPoint> Point(const json& j, const std::string& path) {
   return p;
 }
 
+absl::StatusOr<PlanSection> Section(const json& j, const std::string& path) {
+  if (auto st = CheckKeys(j, path,
+                          {"name", "point_mm", "normal", "width_mm", "region", "tolerance_mm",
+                           "allowed_fraction_outside"});
+      !st.ok())
+    return st;
+  PlanSection s;
+  for (const char* key : {"name", "point_mm", "normal"})
+    if (!j.contains(key)) return Bad(absl::StrCat(path, ".", key), "missing");
+  ASSIGN_OR_RETURN(s.name, String(j["name"], path + ".name"));
+  ASSIGN_OR_RETURN(s.point_mm, Vector3(j["point_mm"], path + ".point_mm"));
+  ASSIGN_OR_RETURN(auto n, Vector3(j["normal"], path + ".normal"));
+  if (!(n.norm() > 1e-12)) return Bad(path + ".normal", "zero vector");
+  s.normal = n.normalized();
+  RETURN_IF_ERROR(OptionalNumber(j, "width_mm", path, s.width_mm));
+  if (j.contains("region")) {
+    ASSIGN_OR_RETURN(s.region, String(j["region"], path + ".region"));
+  }
+  if (j.contains("tolerance_mm")) {
+    ASSIGN_OR_RETURN(auto b, Band(j["tolerance_mm"], path + ".tolerance_mm"));
+    s.tolerance = b;
+  }
+  RETURN_IF_ERROR(OptionalNumber(j, "allowed_fraction_outside", path, s.allowed_fraction_outside));
+  return s;
+}
+
 absl::StatusOr<DefectRules> Defects(const json& j, const std::string& path) {
   if (auto st = CheckKeys(j, path, {"threshold_mm", "min_area_mm2", "max_count"}); !st.ok())
     return st;
@@ -209,10 +235,10 @@ absl::Status List(const json& j, const std::string& path, F parse, std::vector<T
 absl::StatusOr<InspectionPlan> ParseInspectionPlan(const json& j, const TriangleMesh& part,
                                                    const std::string& where,
                                                    const MeshGroups& groups) {
-  if (auto st =
-          CheckKeys(j, where,
-                    {"schema", "tolerance_mm", "allowed_fraction_outside", "min_coverage",
-                     "coverage_distance_mm", "allow_not_measured", "regions", "points", "defects"});
+  if (auto st = CheckKeys(j, where,
+                          {"schema", "tolerance_mm", "allowed_fraction_outside", "min_coverage",
+                           "coverage_distance_mm", "allow_not_measured", "regions", "points",
+                           "sections", "defects"});
       !st.ok())
     return st;
   InspectionPlan plan;
@@ -241,6 +267,8 @@ absl::StatusOr<InspectionPlan> ParseInspectionPlan(const json& j, const Triangle
     RETURN_IF_ERROR(List(j["regions"], where + ".regions", Region, plan.regions));
   if (j.contains("points"))
     RETURN_IF_ERROR(List(j["points"], where + ".points", Point, plan.points));
+  if (j.contains("sections"))
+    RETURN_IF_ERROR(List(j["sections"], where + ".sections", Section, plan.sections));
   if (j.contains("defects")) {
     ASSIGN_OR_RETURN(auto d, Defects(j["defects"], where + ".defects"));
     plan.defects = d;

@@ -44,6 +44,30 @@ absl::StatusOr<InspectionPlan> ParsePlanForMeshFile(
                       absl::StrCat(plan.status().message(), " (", groups.status().message(), ")"));
 }
 
+namespace {
+
+// Each section of the plan cut on the map, limited to its region's triangles.
+absl::StatusOr<std::vector<SectionCut>> CutSections(const ErrorMapResult& em,
+                                                    const TriangleMesh& part,
+                                                    const ResolvedInspectionPlan& rp) {
+  std::vector<SectionCut> out;
+  for (const PlanSection& s : rp.plan.sections) {
+    std::vector<uint8_t> mask;
+    for (std::size_t r = 0; r < rp.plan.regions.size() && !s.region.empty(); ++r) {
+      if (rp.plan.regions[r].name != s.region) continue;
+      mask.assign(rp.num_triangles, 0);
+      for (std::size_t t = 0; t < rp.num_triangles; ++t)
+        for (uint32_t k = rp.region_offsets[t]; k < rp.region_offsets[t + 1]; ++k)
+          mask[t] |= rp.region_ids[k] == r;
+    }
+    ASSIGN_OR_RETURN(auto cut, CutSection(part, em, {s.point_mm, s.normal, s.width_mm}, mask));
+    out.push_back(std::move(cut));
+  }
+  return out;
+}
+
+}  // namespace
+
 bool PlanJudgesCoverage(const InspectionPlan& plan) {
   bool any = plan.min_coverage > 0;
   for (const PlanRegion& r : plan.regions) any |= r.min_coverage.value_or(plan.min_coverage) > 0;
@@ -76,11 +100,13 @@ absl::StatusOr<PlanOutcome> EvaluatePlan(const ErrorMapResult& error_map, const 
                      FindDefects(error_map, cloud, part, *plan.defects, &resolved, ds));
     out.defects_run = true;
   }
+  ASSIGN_OR_RETURN(out.sections, CutSections(error_map, part, resolved));
   CharacteristicsSettings cs;
   cs.threads = threads;
-  ASSIGN_OR_RETURN(out.characteristics,
-                   ComputeCharacteristics(error_map, resolved, out.defects.defects.size(), cs,
-                                          out.coverage_run ? &out.coverage : nullptr));
+  ASSIGN_OR_RETURN(
+      out.characteristics,
+      ComputeCharacteristics(error_map, resolved, out.defects.defects.size(), cs,
+                             out.coverage_run ? &out.coverage : nullptr, out.sections));
   return out;
 }
 

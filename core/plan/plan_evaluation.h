@@ -60,6 +60,7 @@ inline constexpr double kCoverageSpacings = 4.0;
 
 struct PlanOutcome {
   CharacteristicsResult characteristics;  // surface, regions, points
+  std::vector<SectionCut> sections;       // per plan section: the nominal curve, whiskers
   bool coverage_run = false;              // PlanJudgesCoverage
   CoverageResult coverage;                // of the same characteristics, when run
   bool defects_run = false;               // the plan has defect rules

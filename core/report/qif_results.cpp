@@ -54,6 +54,8 @@ struct Characteristic {
   double lower = 0, upper = 0;
   bool has_values = false;  // points > 0: min/max (and value for points) exist
   double min_mm = 0, max_mm = 0, value_mm = 0;
+  // A section is a surface profile of its slab here: QIF's LineProfile
+  // needs the plane's normal, which the report does not carry yet.
   const char* qif_kind() const { return type == "point" ? "PointProfile" : "SurfaceProfile"; }
 };
 
@@ -76,7 +78,7 @@ absl::StatusOr<Characteristic> ReadCharacteristic(const ReportCharacteristic& c,
   }
   if (!std::isfinite(out.lower) || !std::isfinite(out.upper))
     return absl::InvalidArgumentError(absl::StrCat(where, ".tolerance_mm: missing"));
-  if (out.type != "surface" && out.type != "region" && out.type != "point")
+  if (out.type != "surface" && out.type != "region" && out.type != "point" && out.type != "section")
     return absl::InvalidArgumentError(absl::StrCat(where, ".type: unknown \"", out.type, "\""));
   if (out.verdict != "pass" && out.verdict != "fail" && out.verdict != "not_measured")
     return absl::InvalidArgumentError(absl::StrCat(where, ".verdict: not pass/fail/not_measured"));

@@ -255,6 +255,15 @@ TEST(PlanProto, RoundTripsEveryFieldAndUnsetBandsTakeTheSettings) {
   plan.points = {{"P1", {1, 2, 3}, {0, 0, 1}, 2.5, ToleranceBand{-0.1, 0.3}, 0.4},
                  {"P2", {4, 5, 6}, {}, 2.0, {}, {}}};
   plan.points[0].direction = {0, 0.6, 0.8};
+  PlanSection section;
+  section.name = "S1";
+  section.point_mm = {1, 2, 3};
+  section.normal = {0, 1, 0};
+  section.width_mm = 0.5;
+  section.region = "box";
+  section.tolerance = ToleranceBand{-0.2, 0.3};
+  section.allowed_fraction_outside = 0.01;
+  plan.sections = {section};
   plan.defects = DefectRules{0.03, 4.0, 2};
   v1::InspectionPlan msg;
   PlanToProto(plan, &msg);
@@ -276,6 +285,10 @@ TEST(PlanProto, RoundTripsEveryFieldAndUnsetBandsTakeTheSettings) {
   EXPECT_EQ(*back->points[0].min_coverage, 0.4);
   EXPECT_EQ(back->points[0].direction, Eigen::Vector3d(0, 0.6, 0.8));
   EXPECT_EQ(back->points[1].direction, Eigen::Vector3d::Zero());
+  ASSERT_EQ(back->sections.size(), 1u);
+  EXPECT_EQ(back->sections[0].region, "box");
+  EXPECT_EQ(back->sections[0].width_mm, 0.5);
+  EXPECT_EQ(back->sections[0].tolerance->upper_mm, 0.3);
   // An empty message: the surface against +-tolerance_mm, no defects.
   ErrorMapSettings s;
   s.tolerance_mm = 0.3;

@@ -177,6 +177,49 @@ TEST(PlanEvaluation, BadPlansNameTheField) {
       << out.status();
 }
 
+// A section across the scan at x = 20 (through the dent), limited to the
+// region "left" (x <= 25), judged on the points a brute-force selection
+// finds; and sections a plan must refuse, naming the field.
+TEST(PlanEvaluation, ASectionIsJudgedOnThePointsInItsSlab) {
+  const Scene s = MakeScene();
+  nlohmann::json j = PlanJson();
+  j["sections"] = nlohmann::json::parse(R"([{"name": "S20", "point_mm": [20, 0, 0],
+      "normal": [1, 0, 0], "width_mm": 0.5, "region": "left",
+      "tolerance_mm": {"lower": -0.25, "upper": 0.25}}])");
+  auto plan = ParsePlanWithDefaults(j, s.mesh, {});
+  ASSERT_TRUE(plan.ok()) << plan.status();
+  auto out = EvaluatePlan(s.error_map, s.cloud, s.mesh, *plan);
+  ASSERT_TRUE(out.ok()) << out.status();
+  const CharacteristicResult& c = out->characteristics.characteristics.back();
+  EXPECT_EQ(c.name, "S20");
+  EXPECT_EQ(c.type, CharacteristicType::kSection);
+  std::size_t n = 0;
+  double sum = 0, lo = INFINITY;
+  for (std::size_t i = 0; i < s.error_map.triangle_id.size(); ++i) {
+    const Eigen::Vector3f& q = s.error_map.closest_point[i];
+    if (s.error_map.triangle_id[i] == UINT32_MAX || std::abs(q.x() - 20.0) > 0.25 || q.y() > 50)
+      continue;
+    ++n, sum += s.error_map.deviation_mm[i], lo = std::min<double>(lo, s.error_map.deviation_mm[i]);
+  }
+  EXPECT_EQ(c.points, n);
+  EXPECT_NEAR(c.mean_mm, sum / static_cast<double>(n), 1e-12);
+  EXPECT_EQ(c.min_mm, lo);
+  EXPECT_LT(c.min_mm, -0.15) << "through the 0.2 mm dent";
+  EXPECT_TRUE(c.pass) << c.reason;
+  ASSERT_EQ(out->sections.size(), 1u);
+  EXPECT_EQ(out->sections[0].points.size(), n);
+  EXPECT_FALSE(out->sections[0].polylines.empty());
+  for (const auto& [edit, field] : std::vector<std::pair<std::string, std::string>>{
+           {R"({"point_mm": [80, 0, 0]})", "plan.sections[0]: the plane misses the part"},
+           {R"({"width_mm": -1})", "plan.sections[0].width_mm: must be > 0"},
+           {R"({"normal": [0, 0, 0]})", "plan.sections[0].normal: zero vector"},
+           {R"({"region": "nowhere"})", "plan.sections[0].region: no region \"nowhere\""}}) {
+    nlohmann::json b = j;
+    b["sections"][0].merge_patch(nlohmann::json::parse(edit));
+    EXPECT_EQ(ParsePlanWithDefaults(b, s.mesh, {}).status().message(), field);
+  }
+}
+
 TEST(PlanEvaluation, ReportTwoKeepsTheErrorMapBlocksAndAddsTheResults) {
   const Scene s = MakeScene();
   auto plan = ParsePlanWithDefaults(PlanJson(), s.mesh, {});
