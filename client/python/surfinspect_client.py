@@ -259,10 +259,15 @@ def read_cell(path):
 # ---- the inspection plan (docs/inspection-plan.md) ------------------------
 
 _PLAN_KEYS = {
-    "plan": {"schema", "tolerance_mm", "allowed_fraction_outside", "regions", "points", "defects"},
-    "region": {"name", "select", "tolerance_mm", "allowed_fraction_outside"},
+    "plan": {"schema", "tolerance_mm", "allowed_fraction_outside", "min_coverage",
+             "coverage_distance_mm", "allow_not_measured", "regions", "points", "sections",
+             "defects"},
+    "region": {"name", "select", "tolerance_mm", "allowed_fraction_outside", "min_coverage"},
     "select": {"box_mm", "triangles", "group"},
-    "point": {"name", "position_mm", "normal", "radius_mm", "tolerance_mm"},
+    "point": {"name", "position_mm", "normal", "direction", "radius_mm", "tolerance_mm",
+              "min_coverage"},
+    "section": {"name", "point_mm", "normal", "width_mm", "region", "tolerance_mm",
+                "allowed_fraction_outside"},
     "defects": {"threshold_mm", "min_area_mm2", "max_count"},
     "band": {"lower", "upper"},
 }
@@ -306,16 +311,7 @@ def _vector3(values, where):
     return [_number({"v": v}, "v", where) for v in values]
 
 
-def plan_proto(plan):
-    """The JSON plan as the typed InspectionPlan message. Keys and shapes are
-    checked here, naming the field; the server checks the values against the
-    part mesh (INVALID_ARGUMENT "part.plan...")."""
-    msg = pb.InspectionPlan()
-    _keys(plan, "plan", "plan")
-    if "tolerance_mm" in plan:
-        _band(plan["tolerance_mm"], msg.tolerance_mm, "plan.tolerance_mm")
-    if "allowed_fraction_outside" in plan:
-        msg.allowed_fraction_outside = _number(plan, "allowed_fraction_outside", "plan")
+def _regions(plan, msg):
     for i, r in enumerate(plan.get("regions", [])):
         where = f"plan.regions[{i}]"
         _keys(r, "region", where)
@@ -337,19 +333,59 @@ def plan_proto(plan):
             m.select.group = str(s["group"])
         if "tolerance_mm" in r:
             _band(r["tolerance_mm"], m.tolerance_mm, where + ".tolerance_mm")
-        if "allowed_fraction_outside" in r:
-            m.allowed_fraction_outside = _number(r, "allowed_fraction_outside", where)
+        for key in ("allowed_fraction_outside", "min_coverage"):
+            if key in r:
+                setattr(m, key, _number(r, key, where))
+
+
+def _points(plan, msg):
     for i, p in enumerate(plan.get("points", [])):
         where = f"plan.points[{i}]"
         _keys(p, "point", where)
         m = msg.points.add(name=str(p.get("name", "")))
         m.position_mm.extend(_vector3(p.get("position_mm"), where + ".position_mm"))
-        if "normal" in p:
-            m.normal.extend(_vector3(p["normal"], where + ".normal"))
-        if "radius_mm" in p:
-            m.radius_mm = _number(p, "radius_mm", where)
+        for key in ("normal", "direction"):
+            if key in p:
+                getattr(m, key).extend(_vector3(p[key], f"{where}.{key}"))
+        for key in ("radius_mm", "min_coverage"):
+            if key in p:
+                setattr(m, key, _number(p, key, where))
         if "tolerance_mm" in p:
             _band(p["tolerance_mm"], m.tolerance_mm, where + ".tolerance_mm")
+
+
+def _sections(plan, msg):
+    for i, c in enumerate(plan.get("sections", [])):
+        where = f"plan.sections[{i}]"
+        _keys(c, "section", where)
+        m = msg.sections.add(name=str(c.get("name", "")), region=str(c.get("region", "")))
+        m.point_mm.extend(_vector3(c.get("point_mm"), where + ".point_mm"))
+        m.normal.extend(_vector3(c.get("normal"), where + ".normal"))
+        for key in ("width_mm", "allowed_fraction_outside"):
+            if key in c:
+                setattr(m, key, _number(c, key, where))
+        if "tolerance_mm" in c:
+            _band(c["tolerance_mm"], m.tolerance_mm, where + ".tolerance_mm")
+
+
+def plan_proto(plan):
+    """The JSON plan as the typed InspectionPlan message. Keys and shapes are
+    checked here, naming the field; the server checks the values against the
+    part mesh (INVALID_ARGUMENT "part.plan...")."""
+    msg = pb.InspectionPlan()
+    _keys(plan, "plan", "plan")
+    if "tolerance_mm" in plan:
+        _band(plan["tolerance_mm"], msg.tolerance_mm, "plan.tolerance_mm")
+    for key in ("allowed_fraction_outside", "min_coverage", "coverage_distance_mm"):
+        if key in plan:
+            setattr(msg, key, _number(plan, key, "plan"))
+    if "allow_not_measured" in plan:
+        if not isinstance(plan["allow_not_measured"], bool):
+            raise ClientError("plan.allow_not_measured: must be true or false")
+        msg.allow_not_measured = plan["allow_not_measured"]
+    _regions(plan, msg)
+    _points(plan, msg)
+    _sections(plan, msg)
     if "defects" in plan:
         d = plan["defects"]
         _keys(d, "defects", "plan.defects")

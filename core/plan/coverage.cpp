@@ -80,6 +80,11 @@ class TriangleRaster {
     const Eigen::Vector3d b = part.vertices[tri[1]].cast<double>() - o_,
                           c = part.vertices[tri[2]].cast<double>() - o_;
     area_ = 0.5 * b.cross(c).norm();
+    if (!(area_ > 0) || !std::isfinite(area_)) {  // degenerate: one sample, never covered,
+      state_.assign(1, 0);                        // weighing nothing
+      cells_.push_back(0);
+      return;
+    }
     u_ = b.normalized();
     v_ = b.cross(c).cross(b).normalized();
     corner_[0] = Eigen::Vector2d::Zero();
@@ -204,12 +209,13 @@ class TriangleRaster {
     return true;
   }
 
-  Eigen::Vector3d o_, u_, v_;
-  Eigen::Vector2d corner_[3], lo_, outward_[3];  // outward_: unit edge normals
-  Eigen::Vector3f centre_;                       // the bounding sphere of the grid's reach
-  Eigen::Vector3f of_, uf_, vf_;                 // o_, u_, v_ in float, for the points
+  Eigen::Vector3d o_ = Eigen::Vector3d::Zero(), u_ = Eigen::Vector3d::UnitX(),
+                  v_ = Eigen::Vector3d::UnitY();
+  Eigen::Vector2d corner_[3], lo_ = Eigen::Vector2d::Zero(), outward_[3];  // unit edge normals
+  Eigen::Vector3f centre_ = Eigen::Vector3f::Zero();  // the bounding sphere of the grid's reach
+  Eigen::Vector3f of_, uf_, vf_;                      // o_, u_, v_ in float, for the points
   double inv_h_ = 1;
-  float bound2_ = 0;
+  float bound2_ = -1;  // < 0: no point is near (a degenerate triangle)
   double h_ = 1, area_ = 0;
   int nx_ = 1, ny_ = 1, reach_cells_ = 0;
   std::vector<std::size_t> cells_;

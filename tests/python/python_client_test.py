@@ -143,8 +143,10 @@ class PythonClientTest(unittest.TestCase):
         # The exit code and the first line are the part verdict (the typed field).
         verdict = cpp["verdict"]
         self.assertEqual(r.returncode, 0 if verdict == "pass" else 1)
-        failed = [c["name"] for c in cpp["characteristics"] if c["verdict"] != "pass"]
+        failed = [c["name"] for c in cpp["characteristics"] if c["verdict"] == "fail"]
         self.assertEqual(re.findall(r"^  failed ([^:]+):", r.stdout, re.M), failed)
+        unseen = [c["name"] for c in cpp["characteristics"] if c["verdict"] == "not_measured"]
+        self.assertEqual(re.findall(r"^  not measured ([^:]+):", r.stdout, re.M), unseen)
         self.assertEqual(len(re.findall(r"^  defect ", r.stdout, re.M)), len(cpp["defects"]))
         self.assertRegex(r.stdout, rf"(?m)^part-001 {verdict}  min [-+]\d+\.\d{{3}} mm  max [-+]\d+\.\d{{3}} mm$")
         self.assertIn(f"{cpp['statistics']['max_mm']:+.3f}", r.stdout)

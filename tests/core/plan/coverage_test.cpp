@@ -206,6 +206,25 @@ TEST(Coverage, ARegionWhosePointsWereRemovedIsNotMeasured) {
   EXPECT_TRUE(ComputeCharacteristics(s.em, *rp, 0, {})->characteristics[1].measured);
 }
 
+TEST(Coverage, ADegenerateTriangleWeighsNothing) {
+  Sheet s = MakeSheet();
+  auto rp = ResolveInspectionPlan(InspectionPlan{}, s.mesh);
+  ASSERT_TRUE(rp.ok());
+  CoverageSettings cs;
+  cs.distance_mm = 0.8;
+  auto before = ComputeCoverage(s.em, s.mesh, *rp, cs);
+  ASSERT_TRUE(before.ok());
+  const auto v = static_cast<uint32_t>(s.mesh.vertices.size());
+  s.mesh.vertices.insert(s.mesh.vertices.end(), {{1, 1, 0}, {2, 2, 0}, {3, 3, 0}});  // collinear
+  s.mesh.triangles.push_back({v, v + 1, v + 2});
+  rp = ResolveInspectionPlan(InspectionPlan{}, s.mesh);
+  ASSERT_TRUE(rp.ok());
+  auto after = ComputeCoverage(s.em, s.mesh, *rp, cs);
+  ASSERT_TRUE(after.ok()) << after.status();
+  EXPECT_EQ(after->surface, before->surface);
+  EXPECT_EQ(after->triangles.back(), 0.f);
+}
+
 TEST(Coverage, RefusesBadSettings) {
   const Sheet s = MakeSheet();
   auto rp = ResolveInspectionPlan(InspectionPlan{}, s.mesh);
