@@ -43,10 +43,9 @@ TEST(InspectionReport, CharacteristicsCarryTheSchemaFields) {
   const nlohmann::json j = CharacteristicsJson(r);
   ASSERT_TRUE(j.is_array());
   ASSERT_EQ(j.size(), 2u);
-  const std::set<std::string> common = {"name",         "type",      "verdict", "reason",
-                                        "tolerance_mm", "points",    "min_mm",  "max_mm",
-                                        "mean_mm",      "stddev_mm", "rms_mm",  "fraction_within",
-                                        "coverage",     "min_coverage"};
+  const std::set<std::string> common = {
+      "name",   "type",    "verdict",   "reason", "tolerance_mm",    "points",   "min_mm",
+      "max_mm", "mean_mm", "stddev_mm", "rms_mm", "fraction_within", "coverage", "min_coverage"};
   std::set<std::string> area_keys = common, point_keys = common;
   area_keys.insert("allowed_fraction_outside");
   point_keys.insert("value_mm");
@@ -168,7 +167,9 @@ nlohmann::json HandWrittenReport(const ErrorMapResult& r, const ErrorMapSettings
     nlohmann::json k = {
         {"name", c.name},
         {"type", CharacteristicTypeName(c.type)},
-        {"verdict", c.pass ? "pass" : c.measured ? "fail" : "not_measured"},
+        {"verdict", c.pass       ? "pass"
+                    : c.measured ? "fail"
+                                 : "not_measured"},
         {"reason", c.reason},
         {"tolerance_mm", {{"lower", c.tolerance.lower_mm}, {"upper", c.tolerance.upper_mm}}},
         {"coverage", Or(c.coverage)},
