@@ -5,7 +5,6 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 
 #include "core/types/cancel.h"
@@ -38,20 +37,15 @@ Rows<Eigen::Vector3f> PointsByTriangle(const ErrorMapResult& em, std::size_t tri
 
 // The triangles sharing an edge with each triangle.
 Rows<uint32_t> EdgeNeighbours(const TriangleMesh& part) {
-  std::vector<std::array<uint32_t, 3>> edges;  // lower vertex, upper vertex, triangle
-  for (uint32_t t = 0; t < part.num_triangles(); ++t)
-    for (int k = 0; k < 3; ++k) {
-      const uint32_t a = part.triangles[t][k], b = part.triangles[t][(k + 1) % 3];
-      edges.push_back({std::min(a, b), std::max(a, b), t});
-    }
-  std::sort(edges.begin(), edges.end());
+  const std::vector<EdgeUse> edges = SortedEdgeUses(part);
   std::vector<std::vector<uint32_t>> lists(part.num_triangles());
   for (std::size_t i = 0; i < edges.size();) {
     std::size_t j = i;
-    while (j < edges.size() && edges[j][0] == edges[i][0] && edges[j][1] == edges[i][1]) ++j;
+    while (j < edges.size() && edges[j].edge == edges[i].edge) ++j;
     for (std::size_t p = i; p < j; ++p)
       for (std::size_t q = i; q < j; ++q)
-        if (p != q && edges[p][2] != edges[q][2]) lists[edges[p][2]].push_back(edges[q][2]);
+        if (edges[p].triangle != edges[q].triangle)
+          lists[edges[p].triangle].push_back(edges[q].triangle);
     i = j;
   }
   Rows<uint32_t> r;

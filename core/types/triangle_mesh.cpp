@@ -60,21 +60,28 @@ absl::Status TriangleMesh::Validate() const {
   return absl::OkStatus();
 }
 
-MeshTopology AnalyzeTopology(const TriangleMesh& mesh) {
-  // Sort undirected edges and count runs: O(n log n), no hash map needed.
-  std::vector<uint64_t> edges;
+std::vector<EdgeUse> SortedEdgeUses(const TriangleMesh& mesh) {
+  std::vector<EdgeUse> edges;
   edges.reserve(mesh.triangles.size() * 3);
-  for (const auto& tri : mesh.triangles)
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
     for (int k = 0; k < 3; ++k) {
-      uint32_t a = tri[k], b = tri[(k + 1) % 3];
+      uint32_t a = mesh.triangles[t][k], b = mesh.triangles[t][(k + 1) % 3];
       if (a > b) std::swap(a, b);
-      edges.push_back((uint64_t{a} << 32) | b);
+      edges.push_back({(uint64_t{a} << 32) | b, static_cast<uint32_t>(t)});
     }
-  std::sort(edges.begin(), edges.end());
+  std::sort(edges.begin(), edges.end(), [](const EdgeUse& x, const EdgeUse& y) {
+    return x.edge != y.edge ? x.edge < y.edge : x.triangle < y.triangle;
+  });
+  return edges;
+}
+
+MeshTopology AnalyzeTopology(const TriangleMesh& mesh) {
+  // Count the runs of equal edges.
+  const std::vector<EdgeUse> edges = SortedEdgeUses(mesh);
   MeshTopology topo;
   for (std::size_t i = 0; i < edges.size();) {
     std::size_t j = i;
-    while (j < edges.size() && edges[j] == edges[i]) ++j;
+    while (j < edges.size() && edges[j].edge == edges[i].edge) ++j;
     const std::size_t uses = j - i;
     if (uses == 1) ++topo.boundary_edges;
     if (uses >= 3) ++topo.nonmanifold_edges;

@@ -42,6 +42,15 @@ struct MeshTopology {
 };
 MeshTopology AnalyzeTopology(const TriangleMesh& mesh);
 
+// Each triangle's three undirected edges (lower vertex << 32 | upper vertex)
+// sorted by edge, then triangle: a run of equal edges is the triangles that
+// share it. O(n log n), no hash map.
+struct EdgeUse {
+  uint64_t edge = 0;
+  uint32_t triangle = 0;
+};
+std::vector<EdgeUse> SortedEdgeUses(const TriangleMesh& mesh);
+
 Bounds3 ComputeBounds(const TriangleMesh& mesh);
 
 }  // namespace surfinspect
