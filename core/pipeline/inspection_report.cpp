@@ -11,12 +11,6 @@ using nlohmann::json;
 // struct, const when written.
 
 template <typename V, typename R>
-void VisitBand(V& v, R& band) {
-  v("lower", band.lower_mm);
-  v("upper", band.upper_mm);
-}
-
-template <typename V, typename R>
 void VisitCharacteristic(V& v, R& c) {
   v.Require("name");
   v("name", c.name);
@@ -204,6 +198,7 @@ void VisitReport(V& v, R& r) {
     v.List("characteristics", r.characteristics, SURFINSPECT_VISIT(VisitCharacteristic));
     v.List("defects", r.defects, SURFINSPECT_VISIT(VisitDefect));
   }
+  VisitReportSections(v, r.sections);
   v.Object("inputs", r.inputs, SURFINSPECT_VISIT(VisitInputs));
   v.Object("mesh", r.mesh, SURFINSPECT_VISIT(VisitMesh));
   v.Object("cad", r.cad, SURFINSPECT_VISIT(VisitCad));
@@ -285,6 +280,7 @@ absl::StatusOr<InspectionReport> DecodeReport(const json& j) {
   JsonReader r(j, "report");
   VisitReport(r, report);
   if (!r.status().ok()) return r.status();
+  if (absl::Status s = CheckReportSections(report.sections); !s.ok()) return s;
   return report;
 }
 
@@ -365,6 +361,7 @@ InspectionReport MakeInspectionReport(const ErrorMapResult& error_map,
   for (const CharacteristicResult& c : outcome.characteristics.characteristics)
     out.characteristics.push_back(ReportCharacteristicOf(c));
   for (const Defect& d : outcome.defects.defects) out.defects.push_back(ReportDefectOf(d));
+  out.sections = ReportSectionsOf(outcome);
   return out;
 }
 

@@ -21,6 +21,7 @@
 #include "absl/status/statusor.h"
 #include "core/cad/cad_report.h"
 #include "core/errormap/error_map.h"
+#include "core/pipeline/report_section.h"
 #include "core/plan/characteristics.h"
 #include "core/plan/defects.h"
 #include "core/plan/plan_evaluation.h"
@@ -136,6 +137,7 @@ struct InspectionReport {
   ReportTiming timing;
   std::vector<ReportCharacteristic> characteristics;
   std::vector<ReportDefect> defects;
+  std::vector<ReportSection> sections;  // the plan's sections, in plan order; "sections"
   // Written by the CLI's errormap only.
   std::optional<ReportInputs> inputs;
   std::optional<ReportMesh> mesh;

@@ -8,6 +8,7 @@
 #include "core/io/atomic_file.h"
 #include "core/report/html_escape.h"
 #include "core/report/html_histogram.h"
+#include "core/report/html_section_plot.h"
 #include "core/report/viewer_assets.h"
 #include "core/report/viewer_page.h"
 #include "core/types/status_macros.h"
@@ -61,12 +62,13 @@ std::string Title(const HtmlReportContext& ctx, const InspectionReport& report) 
 
 std::string SidePane(const InspectionReport& report, const HtmlReportContext& ctx,
                      const DeviationPalette& palette) {
-  return absl::StrCat("<aside id=\"side\">\n<h2>Characteristics</h2>\n",
-                      CharacteristicsTable(report), "<h2>Defects</h2>\n", DefectsTable(report),
-                      "<h2>Histogram</h2>\n", HistogramSvg(report.histogram, palette),
-                      "<h2>Statistics (all points)</h2>\n", StatisticsTable(report),
-                      "<h2>Calibration</h2>\n", CalibrationTable(ctx), "<h2>Settings</h2>\n",
-                      SettingsTable(report), "</aside>\n");
+  const std::string sections = SectionPlotsHtml(report, palette);
+  return absl::StrCat(
+      "<aside id=\"side\">\n<h2>Characteristics</h2>\n", CharacteristicsTable(report),
+      "<h2>Defects</h2>\n", DefectsTable(report), sections.empty() ? "" : "<h2>Sections</h2>\n",
+      sections, "<h2>Histogram</h2>\n", HistogramSvg(report.histogram, palette),
+      "<h2>Statistics (all points)</h2>\n", StatisticsTable(report), "<h2>Calibration</h2>\n",
+      CalibrationTable(ctx), "<h2>Settings</h2>\n", SettingsTable(report), "</aside>\n");
 }
 
 absl::Status CheckInput(const HtmlReportInput& in) {

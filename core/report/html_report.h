@@ -3,7 +3,8 @@
 // scanned points (part frame, coloured with the error map's palette, grey
 // where unmatched; the CAD mesh as a translucent overlay that can be
 // switched off; defects marked by their ids) it shows the part verdict, the
-// characteristics (failed first), the defects, the histogram, the
+// characteristics (failed first), the defects, a 2D plot of each plan
+// section (core/report/html_section_plot.h), the histogram, the
 // statistics (always over all points, from the report), the settings and
 // each viewpoint's calibration status.
 //

@@ -13,6 +13,7 @@
 #include "core/report/error_map_png.h"
 #include "core/report/pdf_canvas.h"
 #include "core/report/report_content.h"
+#include "core/report/section_plot.h"
 #include "core/types/status_macros.h"
 #include "core/types/transform.h"
 
@@ -41,6 +42,9 @@ struct Pages {
   }
   void Need(double h) {
     if (y + h <= kBottom) return;
+    Break();
+  }
+  void Break() {
     canvas.NewPage();
     Footer();
     y = kTop;
@@ -229,6 +233,56 @@ void DrawTable(Pages& p, const std::string& title, const ReportTable& t,
   p.y += 12;
 }
 
+// One section's plot (core/report/section_plot.h) scaled into the box (x,
+// y, w, h), y up, with a thin frame: the band's bars, the nominal curve and
+// the whiskers, as the HTML report draws them.
+void DrawSectionPlot(PdfCanvas& cv, const SectionPlot& plot, double x, double y, double w,
+                     double h) {
+  const Rgb frame{200, 200, 200};
+  cv.Line(x, y, x + w, y, 0.4, frame);
+  cv.Line(x, y + h, x + w, y + h, 0.4, frame);
+  cv.Line(x, y, x, y + h, 0.4, frame);
+  cv.Line(x + w, y, x + w, y + h, 0.4, frame);
+  if (plot.empty()) return;
+  const Eigen::Vector2d size = (plot.max - plot.min).cwiseMax(1e-3);
+  const double scale = 0.92 * std::min(w / size.x(), h / size.y());
+  const Eigen::Vector2d centre = 0.5 * (plot.min + plot.max);
+  auto line = [&](const Eigen::Vector2d& a, const Eigen::Vector2d& b, double width, Rgb color) {
+    cv.Line(x + w / 2 + (a.x() - centre.x()) * scale, y + h / 2 - (a.y() - centre.y()) * scale,
+            x + w / 2 + (b.x() - centre.x()) * scale, y + h / 2 - (b.y() - centre.y()) * scale,
+            width, color);
+  };
+  for (const SectionPlot::Bar& b : plot.band) line(b.lower, b.upper, 2.5, {191, 227, 191});
+  for (const auto& curve : plot.curve)
+    for (std::size_t i = 0; i + 1 < curve.size(); ++i) line(curve[i], curve[i + 1], 0.9, kInk);
+  for (const SectionPlot::Whisker& wh : plot.whiskers) line(wh.foot, wh.tip, 0.5, wh.color);
+}
+
+// The sections from a new page, six to a page (two across, three down),
+// each with its title above and its caption (the exaggeration) below.
+void DrawSections(Pages& p, const InspectionReport& report, const ReportContent& c) {
+  if (report.sections.empty()) return;
+  const DeviationPalette palette = MakeDeviationPalette(c.tolerance_mm, c.color_range_mm);
+  constexpr int kAcross = 2, kPerPage = 6;
+  constexpr double kHeading = 20, kGap = 12, kTitle = 22, kCaption = 20;
+  const double cell_w = (kWidth - kGap) / kAcross;
+  const double cell_h = (kBottom - kTop - kHeading) / (kPerPage / kAcross);
+  for (std::size_t i = 0; i < report.sections.size(); ++i) {
+    if (i % kPerPage == 0) {
+      p.Break();
+      p.y += p.canvas.Text(kLeft, p.y, "Sections (mm in the section plane)", {10, true}) + 6;
+    }
+    const ReportSection& s = report.sections[i];
+    const SectionPlot plot = MakeSectionPlot(s, palette);
+    const double x = kLeft + (i % kAcross) * (cell_w + kGap);
+    const double y = p.y + ((i % kPerPage) / kAcross) * cell_h;
+    p.canvas.Text(x, y, SectionPlotTitle(report, s), {7.5, true}, cell_w);
+    DrawSectionPlot(p.canvas, plot, x, y + kTitle, cell_w, cell_h - kTitle - kCaption - 4);
+    p.canvas.Text(x, y + cell_h - kCaption - 2, SectionPlotCaption(s, plot), {6.5, false, kGrey},
+                  cell_w);
+  }
+}
+
 }  // namespace
 
 std::string SoftwareVersion() { return absl::StrCat("surfinspect ", SURFINSPECT_VERSION); }
@@ -255,6 +309,7 @@ absl::StatusOr<std::string> RenderPdfReport(const PdfReportInput& in) {
   DrawTable(p, "Characteristics (failed first)", c.characteristics,
             {118, 42, 36, 78, 52, 45, 45, 47, 52});
   DrawTable(p, "Defects", c.defects, {30, 32, 118, 50, 50, 50, 45, 140});
+  DrawSections(p, *in.report, c);
   return p.canvas.Finish();
 }
 

@@ -6,9 +6,10 @@
 // defects' ids, the colour bar with the tolerance band bracketed, the
 // log-count histogram on the same deviation axis, and the statistics. Then
 // the characteristics table (failed rows first) and the defects table,
-// continued on as many pages as they need. The content comes from the
-// typed report (core/report/report_content.h); the maps are drawn by
-// core/report/error_map_png.h's renderer.
+// continued on as many pages as they need; when the report has sections,
+// pages of section plots follow, six to a page (core/report/section_plot.h).
+// The content comes from the typed report (core/report/report_content.h);
+// the maps are drawn by core/report/error_map_png.h's renderer.
 #pragma once
 
 #include <string>

@@ -43,6 +43,12 @@ std::string NoSpace(const std::string& s) {
   return out;
 }
 
+std::size_t Count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
 // The "Pages:" count of pdfinfo's output; -1 when absent.
 int Pages(const std::string& info) {
   const std::size_t at = info.find("Pages:");
@@ -228,6 +234,60 @@ TEST(PdfReport, LongTablesContinueOnMorePages) {
   for (std::string w; text >> w;) words.insert(w);
   for (int i = 0; i < 120; ++i) EXPECT_EQ(words.count("row-" + std::to_string(i)), 1u) << i;
   EXPECT_GE(words.count("characteristic"), 2u) << "the header repeats on the next page";
+}
+
+// Seven sections: pages of section plots after page 1, six to a page, each
+// plot titled with its name and captioned with its exaggeration; the
+// whiskers outside the band are drawn in the palette's colours.
+TEST(PdfReport, SectionsGetPagesOfPlots) {
+  if (!HavePoppler()) GTEST_SKIP() << "poppler-utils not installed: PDF NOT CHECKED";
+  const Cloud c = MakeCloud(true);
+  InspectionReport report = Report("r");
+  for (int k = 0; k < 7; ++k) {
+    ReportSection s;
+    s.name = "cut-" + std::to_string(k);
+    s.point_mm = {0, 0, 0};
+    s.normal = {1, 0, 0};
+    s.tolerance = {-0.1, 0.1};
+    ReportPolyline line;
+    for (int i = 0; i <= 20; ++i) line.xyz_mm.insert(line.xyz_mm.end(), {0.0, i - 10.0, 0.0});
+    s.polylines = {line};
+    for (int i = 0; i < 40; ++i) {
+      s.whiskers.at_mm.insert(s.whiskers.at_mm.end(), {0.0, i / 2.0 - 10, 0.0});
+      s.whiskers.direction.insert(s.whiskers.direction.end(), {0.0, 0.0, 1.0});
+      s.whiskers.deviation_mm.push_back(i % 2 ? 0.4 : -0.4);
+    }
+    report.sections.push_back(s);
+  }
+  PdfReportInput in;
+  in.part_id = "p";
+  in.report = &report;
+  in.points_in_part = &c.points;
+  in.deviation_mm = &c.deviation;
+  TempDir dir;
+  ASSERT_TRUE(WritePdfReport(dir.File("r.pdf"), in).ok());
+  EXPECT_EQ(Pages(Shell("pdfinfo '" + dir.File("r.pdf") + "'")), 3) << "page 1, then 6 + 1";
+  const std::string text = Shell("pdftotext -raw '" + dir.File("r.pdf") + "' -");
+  for (int k = 0; k < 7; ++k) EXPECT_NE(text.find("cut-" + std::to_string(k)), std::string::npos);
+  // Extent 20 mm, band 0.2 mm: 0.05 * 20 / 0.2 = 5.
+  EXPECT_EQ(Count(text, "whiskers x 5, band -0.100..+0.100 mm"), 7u) << text;
+  EXPECT_EQ(Count(text, "Sections (mm in the section plane)"), 2u);
+  // Page 3 holds one plot: strongly coloured pixels (whiskers at +-0.4 mm,
+  // outside the band) in its first cell and none in the others.
+  Shell("pdftoppm -f 3 -l 3 -r 72 -png '" + dir.File("r.pdf") + "' '" + dir.File("pg") + "'");
+  const RgbImage page = testing::DecodePng(testing::ReadBytes(dir.File("pg-3.png")));
+  auto coloured = [&](uint32_t x0, uint32_t x1, uint32_t y0, uint32_t y1) {
+    std::size_t n = 0;
+    for (uint32_t y = y0; y < y1; ++y)
+      for (uint32_t x = x0; x < x1; ++x) {
+        const Rgb p = page.at(x, y);
+        n += std::max({p.r, p.g, p.b}) - std::min({p.r, p.g, p.b}) > 60 ? 1 : 0;
+      }
+    return n;
+  };
+  EXPECT_GT(coloured(40, 290, 60, 300), 100u);
+  EXPECT_EQ(coloured(300, 555, 60, 800), 0u);
+  EXPECT_EQ(coloured(40, 290, 310, 800), 0u);
 }
 
 TEST(PdfCanvas, SoftwareVersionNamesTheProject) {
