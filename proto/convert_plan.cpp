@@ -80,6 +80,45 @@ absl::StatusOr<PlanSection> SectionFromProto(const v1::PlanSection& msg, const s
   return s;
 }
 
+absl::StatusOr<PlanHole> HoleFromProto(const v1::PlanHole& msg, const std::string& field) {
+  PlanHole h;
+  h.name = msg.name();
+  h.slot = msg.slot();
+  ASSIGN_OR_RETURN(h.position_mm, Vector3FromProto(msg.position_mm(), field + ".position_mm"));
+  ASSIGN_OR_RETURN(auto a, Vector3FromProto(msg.axis(), field + ".axis"));
+  if (!(a.norm() > 0) || !a.allFinite())
+    return Invalid(field + ".axis", "must be a finite non-zero vector");
+  h.axis = a.normalized();
+  h.diameter_mm = msg.diameter_mm();
+  if (msg.has_position_tolerance_mm()) h.position_tolerance_mm = msg.position_tolerance_mm();
+  if (msg.has_diameter_tolerance_mm())
+    h.diameter_tolerance = BandFromProto(msg.diameter_tolerance_mm());
+  if (msg.has_min_arc_deg()) h.min_arc_deg = msg.min_arc_deg();
+  if (!h.slot) return h;
+  h.length_mm = msg.length_mm();
+  ASSIGN_OR_RETURN(auto d, Vector3FromProto(msg.direction(), field + ".direction"));
+  if (!(d.norm() > 0) || !d.allFinite())
+    return Invalid(field + ".direction", "must be a finite non-zero vector");
+  h.direction = d.normalized();
+  if (msg.has_length_tolerance_mm()) h.length_tolerance = BandFromProto(msg.length_tolerance_mm());
+  return h;
+}
+
+void HoleToProto(const PlanHole& h, v1::PlanHole* m) {
+  m->set_name(h.name);
+  m->set_slot(h.slot);
+  Vector3ToProto(h.position_mm, m->mutable_position_mm());
+  Vector3ToProto(h.axis, m->mutable_axis());
+  m->set_diameter_mm(h.diameter_mm);
+  m->set_position_tolerance_mm(h.position_tolerance_mm);
+  BandToProto(h.diameter_tolerance, m->mutable_diameter_tolerance_mm());
+  m->set_min_arc_deg(h.min_arc_deg);
+  if (!h.slot) return;
+  m->set_length_mm(h.length_mm);
+  Vector3ToProto(h.direction, m->mutable_direction());
+  BandToProto(h.length_tolerance, m->mutable_length_tolerance_mm());
+}
+
 }  // namespace
 
 absl::StatusOr<InspectionPlan> PlanFromProto(const v1::InspectionPlan& msg,
@@ -106,6 +145,10 @@ absl::StatusOr<InspectionPlan> PlanFromProto(const v1::InspectionPlan& msg,
     ASSIGN_OR_RETURN(auto s,
                      SectionFromProto(msg.sections(i), absl::StrCat(field, ".sections[", i, "]")));
     plan.sections.push_back(std::move(s));
+  }
+  for (int i = 0; i < msg.holes_size(); ++i) {
+    ASSIGN_OR_RETURN(auto h, HoleFromProto(msg.holes(i), absl::StrCat(field, ".holes[", i, "]")));
+    plan.holes.push_back(std::move(h));
   }
   if (msg.has_defects()) {
     DefectRules d;
@@ -166,6 +209,7 @@ void PlanToProto(const InspectionPlan& plan, v1::InspectionPlan* msg) {
     if (s.tolerance) BandToProto(*s.tolerance, m->mutable_tolerance_mm());
     m->set_allowed_fraction_outside(s.allowed_fraction_outside);
   }
+  for (const PlanHole& h : plan.holes) HoleToProto(h, msg->add_holes());
   if (plan.defects) {
     v1::DefectRules* d = msg->mutable_defects();
     d->set_threshold_mm(plan.defects->threshold_mm);

@@ -91,8 +91,49 @@ v1::CharacteristicType TypeToProto(CharacteristicType t) {
       return v1::CHARACTERISTIC_POINT;
     case CharacteristicType::kSection:
       return v1::CHARACTERISTIC_SECTION;
+    case CharacteristicType::kHole:
+      return v1::CHARACTERISTIC_HOLE;
+    case CharacteristicType::kSlot:
+      return v1::CHARACTERISTIC_SLOT;
   }
   return v1::CHARACTERISTIC_TYPE_UNSPECIFIED;
+}
+
+void HoleToProto(const CharacteristicResult& c, v1::HoleResult* msg) {
+  const HoleMeasurement& h = c.hole;
+  Vector3ToProto(h.measured_position_mm, msg->mutable_measured_position_mm());
+  Vector3ToProto(h.position_deviation_mm, msg->mutable_position_deviation_mm());
+  msg->set_true_position_mm(h.true_position_mm);
+  msg->set_position_tolerance_mm(c.position_tolerance_mm);
+  msg->set_measured_diameter_mm(h.diameter_mm);
+  msg->set_diameter_deviation_mm(h.diameter_deviation_mm);
+  msg->set_measured_length_mm(h.length_mm);
+  msg->set_length_deviation_mm(h.length_deviation_mm);
+  BandToProto(c.length_tolerance, msg->mutable_length_tolerance_mm());
+  msg->set_form_mm(h.form_mm);
+  msg->set_arc_coverage_deg(h.arc_coverage_deg);
+  msg->set_pixel_pitch_mm(h.pixel_pitch_mm);
+}
+
+void HoleFromProto(const v1::HoleResult& m, CharacteristicResult* c) {
+  HoleMeasurement& h = c->hole;
+  auto vec = [](const google::protobuf::RepeatedField<double>& v) {
+    return v.size() == 3 ? Eigen::Vector3d(v[0], v[1], v[2]) : Eigen::Vector3d::Constant(NAN);
+  };
+  h.measured = c->measured;
+  h.measured_position_mm = vec(m.measured_position_mm());
+  h.position_deviation_mm = vec(m.position_deviation_mm());
+  h.true_position_mm = m.true_position_mm();
+  c->position_tolerance_mm = m.position_tolerance_mm();
+  h.diameter_mm = m.measured_diameter_mm();
+  h.diameter_deviation_mm = m.diameter_deviation_mm();
+  h.length_mm = m.measured_length_mm();
+  h.length_deviation_mm = m.length_deviation_mm();
+  c->length_tolerance = BandFromProto(m.length_tolerance_mm());
+  h.form_mm = m.form_mm();
+  h.arc_coverage_deg = m.arc_coverage_deg();
+  h.pixel_pitch_mm = m.pixel_pitch_mm();
+  h.edge_points = c->points;
 }
 
 void CharacteristicToProto(const CharacteristicResult& c, v1::CharacteristicResult* msg) {
@@ -114,6 +155,7 @@ void CharacteristicToProto(const CharacteristicResult& c, v1::CharacteristicResu
   msg->set_allowed_fraction_outside(c.allowed_fraction_outside);
   msg->set_coverage(c.coverage);
   msg->set_min_coverage(c.min_coverage);
+  if (c.is_hole()) HoleToProto(c, msg->mutable_hole());
 }
 
 void DefectToProto(const Defect& d, v1::DefectResult* msg) {
@@ -153,6 +195,8 @@ CharacteristicsResult CharacteristicsFromProto(
     c.type = m.type() == v1::CHARACTERISTIC_REGION    ? CharacteristicType::kRegion
              : m.type() == v1::CHARACTERISTIC_POINT   ? CharacteristicType::kPoint
              : m.type() == v1::CHARACTERISTIC_SECTION ? CharacteristicType::kSection
+             : m.type() == v1::CHARACTERISTIC_HOLE    ? CharacteristicType::kHole
+             : m.type() == v1::CHARACTERISTIC_SLOT    ? CharacteristicType::kSlot
                                                       : CharacteristicType::kSurface;
     c.pass = m.verdict() == v1::VERDICT_PASS;
     c.measured = m.verdict() != v1::VERDICT_NOT_MEASURED;
@@ -169,6 +213,7 @@ CharacteristicsResult CharacteristicsFromProto(
     c.fraction_within = m.fraction_within();
     c.value_mm = m.value_mm();
     c.allowed_fraction_outside = m.allowed_fraction_outside();
+    if (c.is_hole()) HoleFromProto(m.hole(), &c);
     out.failed += !c.pass && c.measured;
     out.not_measured += !c.measured;
     out.characteristics.push_back(std::move(c));

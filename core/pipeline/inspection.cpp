@@ -41,10 +41,16 @@ absl::StatusOr<InspectionResult> InspectPart(const MeshIndex& part,
       ComputeErrorMap(part, out.merged.cloud_in_world, world_from_part, settings.error_map, cancel);
   if (!map.ok()) return map.status();
   out.error_map = *std::move(map);
+  // The views as the plan measures holes on them: filtered, in the part frame.
+  std::vector<PlanView> plan_views;
+  if (settings.plan && !settings.plan->holes.empty())
+    for (const ViewScan& v : views)
+      plan_views.push_back(
+          {v.name, &v.cloud_in_sensor, world_from_part.inverse() * v.world_from_sensor});
   ASSIGN_OR_RETURN(
       out.plan, EvaluatePlan(out.error_map, out.merged.cloud_in_world, part.mesh(),
                              settings.plan ? *settings.plan : PlanFromSettings(settings.error_map),
-                             settings.error_map.threads, cancel));
+                             settings.error_map.threads, cancel, plan_views));
   if (progress) progress(InspectionStage::kErrorMap, "", out.error_map.stats.matched);
   return out;
 }

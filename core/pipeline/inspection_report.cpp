@@ -1,5 +1,7 @@
 #include "core/pipeline/inspection_report.h"  // and core/types/json_fields.h
 
+#include "core/pipeline/report_results.h"
+
 namespace surfinspect {
 namespace {
 
@@ -9,6 +11,26 @@ using nlohmann::json;
 // fields in reading order (core/types/json_fields.h): the same function
 // writes, reads and lists it, so a key exists in one place. R is the part's
 // struct, const when written.
+
+// A hole's or slot's own fields; a slot names its size width, not diameter.
+template <typename V, typename R>
+void VisitHole(V& v, R& c) {
+  const bool slot = c.type == "slot";
+  v("measured_position_mm", c.measured_position_mm);
+  v("position_deviation_mm", c.position_deviation_mm);
+  v("true_position_mm", c.true_position_mm);
+  v("position_tolerance_mm", c.position_tolerance_mm);
+  v(slot ? "measured_width_mm" : "measured_diameter_mm", c.measured_diameter_mm);
+  v(slot ? "width_deviation_mm" : "diameter_deviation_mm", c.diameter_deviation_mm);
+  if (slot) {
+    v("measured_length_mm", c.measured_length_mm);
+    v("length_deviation_mm", c.length_deviation_mm);
+    v.Object("length_tolerance_mm", c.length_tolerance, [](auto& w, auto& b) { VisitBand(w, b); });
+  }
+  v("form_mm", c.form_mm);
+  v("arc_coverage_deg", c.arc_coverage_deg);
+  v("pixel_pitch_mm", c.pixel_pitch_mm);
+}
 
 template <typename V, typename R>
 void VisitCharacteristic(V& v, R& c) {
@@ -29,6 +51,8 @@ void VisitCharacteristic(V& v, R& c) {
   v("fraction_within", c.fraction_within);
   if (c.is_point())
     v("value_mm", c.value_mm);
+  else if (c.is_hole())
+    VisitHole(v, c);
   else
     v("allowed_fraction_outside", c.allowed_fraction_outside);
 }
@@ -223,43 +247,6 @@ json EncodeDefect(const ReportDefect& d) {
   JsonWriter w;
   VisitDefect(w, d);
   return std::move(w.out);
-}
-
-ReportCharacteristic ReportCharacteristicOf(const CharacteristicResult& c) {
-  ReportCharacteristic out;
-  out.name = c.name;
-  out.type = CharacteristicTypeName(c.type);
-  out.verdict = VerdictName(c);
-  out.reason = c.reason;
-  out.coverage = c.coverage;
-  out.min_coverage = c.min_coverage;
-  out.tolerance = c.tolerance;
-  out.points = c.points;
-  out.min_mm = c.min_mm;
-  out.max_mm = c.max_mm;
-  out.mean_mm = c.mean_mm;
-  out.stddev_mm = c.stddev_mm;
-  out.rms_mm = c.rms_mm;
-  out.fraction_within = c.fraction_within;
-  out.value_mm = c.value_mm;
-  out.allowed_fraction_outside = c.allowed_fraction_outside;
-  return out;
-}
-
-ReportDefect ReportDefectOf(const Defect& d) {
-  ReportDefect out;
-  out.id = d.id;
-  out.kind = DefectKindName(d.kind);
-  out.centroid_mm = d.centroid_mm;
-  out.area_mm2 = d.area_mm2;
-  out.extent_mm = d.extent_mm;
-  out.peak_mm = d.peak_mm;
-  out.peak_source = d.peak_fitted ? "fit" : "median";
-  out.measured_extreme_mm = d.measured_extreme_mm;
-  out.noise_mm = d.noise_mm;
-  out.points = d.points;
-  out.region = d.region;
-  return out;
 }
 
 }  // namespace

@@ -52,9 +52,9 @@ struct ReportTolerance {
 // One characteristic of the plan, as judged.
 struct ReportCharacteristic {
   std::string name;
-  std::string type;                   // "surface" | "region" | "point"
-  std::string verdict;                // "pass" | "fail" | "not_measured"
-  std::string reason;                 // one line, for people
+  std::string type;     // "surface" | "region" | "point" | "section" | "hole" | "slot"
+  std::string verdict;  // "pass" | "fail" | "not_measured"
+  std::string reason;   // one line, for people
   ToleranceBand tolerance{NAN, NAN};  // NaN when not said
   // The covered fraction of its CAD area and the least it needed
   // (core/plan/coverage.h); NaN in a report from before coverage.
@@ -64,7 +64,20 @@ struct ReportCharacteristic {
   double fraction_within = NAN;
   double value_mm = NAN;                  // points only
   double allowed_fraction_outside = NAN;  // surface and regions only
+  // Holes and slots (core/plan/holes.h): the measured centre in the plan
+  // plane, its deviation from the nominal, the true position and its zone;
+  // the diameter (a slot's width) and a slot's length with their
+  // deviations; the form, the edge's arc seen and the pixel pitch there.
+  // `points` are the edge points kept, `tolerance_mm` the diameter's band.
+  Eigen::Vector3d measured_position_mm = Eigen::Vector3d::Constant(NAN);
+  Eigen::Vector3d position_deviation_mm = Eigen::Vector3d::Constant(NAN);
+  double true_position_mm = NAN, position_tolerance_mm = NAN;
+  double measured_diameter_mm = NAN, diameter_deviation_mm = NAN;
+  double measured_length_mm = NAN, length_deviation_mm = NAN;
+  ToleranceBand length_tolerance{NAN, NAN};
+  double form_mm = NAN, arc_coverage_deg = NAN, pixel_pitch_mm = NAN;
   bool is_point() const { return type == "point"; }
+  bool is_hole() const { return type == "hole" || type == "slot"; }
   bool passed() const { return verdict == "pass"; }
   bool measured() const { return verdict != "not_measured"; }
   bool operator==(const ReportCharacteristic& o) const;

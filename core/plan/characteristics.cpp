@@ -9,6 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
 
 namespace surfinspect {
 namespace {
@@ -212,6 +213,44 @@ CharacteristicResult JudgeSection(const ErrorMapResult& em, const InspectionPlan
   return c;
 }
 
+// A hole judged by its true position and size deviations.
+CharacteristicResult JudgeHole(const PlanHole& h, const HoleMeasurement& m) {
+  CharacteristicResult c;
+  c.name = h.name;
+  c.type = h.slot ? CharacteristicType::kSlot : CharacteristicType::kHole;
+  c.tolerance = h.diameter_tolerance;
+  c.position_tolerance_mm = h.position_tolerance_mm;
+  if (h.slot) c.length_tolerance = h.length_tolerance;
+  c.hole = m;
+  c.points = m.edge_points;
+  if (!m.measured) {
+    c.measured = false;
+    c.reason = "not measured: " + m.reason;
+    return c;
+  }
+  const char* size = h.slot ? "width" : "diameter";
+  std::vector<std::string> failed;
+  if (!(m.true_position_mm <= h.position_tolerance_mm))
+    failed.push_back(absl::StrFormat("true position %.3f mm > %.3g mm", m.true_position_mm,
+                                     h.position_tolerance_mm));
+  if (!h.diameter_tolerance.Contains(float(m.diameter_deviation_mm)))
+    failed.push_back(absl::StrFormat("%s %+.3f mm outside [%+.3g, %+.3g]", size,
+                                     m.diameter_deviation_mm, h.diameter_tolerance.lower_mm,
+                                     h.diameter_tolerance.upper_mm));
+  if (h.slot && !h.length_tolerance.Contains(float(m.length_deviation_mm)))
+    failed.push_back(absl::StrFormat("length %+.3f mm outside [%+.3g, %+.3g]",
+                                     m.length_deviation_mm, h.length_tolerance.lower_mm,
+                                     h.length_tolerance.upper_mm));
+  c.pass = failed.empty();
+  c.reason = c.pass ? absl::StrFormat(
+                          "pass: true position %.3f of %.3g mm, %s %+.3f mm (%u edge "
+                          "points over %.0f deg)",
+                          m.true_position_mm, h.position_tolerance_mm, size,
+                          m.diameter_deviation_mm, m.edge_points, m.arc_coverage_deg)
+                    : "fail: " + absl::StrJoin(failed, "; ");
+  return c;
+}
+
 }  // namespace
 
 const char* VerdictName(const CharacteristicResult& c) {
@@ -228,6 +267,10 @@ const char* CharacteristicTypeName(CharacteristicType type) {
       return "point";
     case CharacteristicType::kSection:
       return "section";
+    case CharacteristicType::kHole:
+      return "hole";
+    case CharacteristicType::kSlot:
+      return "slot";
   }
   return "surface";
 }
@@ -235,10 +278,12 @@ const char* CharacteristicTypeName(CharacteristicType type) {
 absl::StatusOr<CharacteristicsResult> ComputeCharacteristics(
     const ErrorMapResult& em, const ResolvedInspectionPlan& rp, std::size_t defect_count,
     const CharacteristicsSettings& settings, const CoverageResult* coverage,
-    const std::vector<SectionCut>& sections) {
+    const std::vector<SectionCut>& sections, const std::vector<HoleMeasurement>& holes) {
   const std::size_t n = em.deviation_mm.size();
   if (sections.size() != rp.plan.sections.size())
     return absl::InvalidArgumentError("characteristics: one cut per section of the plan");
+  if (holes.size() != rp.plan.holes.size())
+    return absl::InvalidArgumentError("characteristics: one measurement per hole of the plan");
   if (coverage && (coverage->regions.size() != rp.plan.regions.size() ||
                    coverage->points.size() != rp.plan.points.size()))
     return absl::InvalidArgumentError("characteristics: the coverage is of another plan");
@@ -277,6 +322,12 @@ absl::StatusOr<CharacteristicsResult> ComputeCharacteristics(
   for (std::size_t s = 0; s < sections.size(); ++s) {
     CharacteristicResult c = JudgeSection(em, rp.plan, rp.plan.sections[s], sections[s]);
     out.failed += !c.pass;
+    out.characteristics.push_back(std::move(c));
+  }
+  for (std::size_t h = 0; h < holes.size(); ++h) {
+    CharacteristicResult c = JudgeHole(rp.plan.holes[h], holes[h]);
+    out.failed += !c.pass && c.measured;
+    out.not_measured += !c.measured;
     out.characteristics.push_back(std::move(c));
   }
   const bool too_many_defects =

@@ -7,6 +7,9 @@
 //  * A comparison point's value is the mean signed deviation of the scanned
 //    points whose closest CAD point lies within radius_mm of position_mm; it
 //    has no value (failing) when there is none.
+//  * A hole or slot passes when it was measured (its edge seen over at
+//    least min_arc_deg), its true position is within its zone and its
+//    diameter (a slot's width and length) deviates within its band.
 //  * A surface, region or section passes when it has matched points and
 //    the fraction outside its band is at most allowed_fraction_outside
 //    (a section's points are those CutSection selected); a point passes
@@ -32,13 +35,14 @@
 #include "absl/status/statusor.h"
 #include "core/errormap/error_map.h"
 #include "core/plan/coverage.h"
+#include "core/plan/holes.h"
 #include "core/plan/inspection_plan.h"
 #include "core/plan/section.h"
 
 namespace surfinspect {
 
-enum class CharacteristicType { kSurface, kRegion, kPoint, kSection };
-// "surface" | "region" | "point" | "section"
+enum class CharacteristicType { kSurface, kRegion, kPoint, kSection, kHole, kSlot };
+// "surface" | "region" | "point" | "section" | "hole" | "slot"
 const char* CharacteristicTypeName(CharacteristicType type);
 
 struct CharacteristicResult {
@@ -57,10 +61,20 @@ struct CharacteristicResult {
   double min_mm = NAN, max_mm = NAN, mean_mm = NAN, stddev_mm = NAN, rms_mm = NAN;
   double fraction_within = NAN;
   double value_mm = NAN;  // points only: the mean; NaN when no point is near
+  // Holes and slots: the measurement (core/plan/holes.h) and the true
+  // position zone it was judged against; `tolerance` is the diameter's (a
+  // slot's width's) band, `points` the edge points kept by the fit.
+  HoleMeasurement hole;
+  double position_tolerance_mm = NAN;
+  ToleranceBand length_tolerance{NAN, NAN};  // slots only
+  bool is_hole() const {
+    return type == CharacteristicType::kHole || type == CharacteristicType::kSlot;
+  }
 };
 
 struct CharacteristicsResult {
-  std::vector<CharacteristicResult> characteristics;  // surface, regions, points, in plan order
+  // surface, regions, points, sections, holes (then slots), in plan order
+  std::vector<CharacteristicResult> characteristics;
   bool pass = false;       // every characteristic passes (and the defect count rule, when set)
   std::size_t failed = 0;  // characteristics that were measured and fail
   std::size_t not_measured = 0;
@@ -80,9 +94,11 @@ const char* VerdictName(const CharacteristicResult& c);
 // `coverage` (of the same plan and map) is judged when given. `sections`
 // holds the plan's sections cut on the same map (CutSection), one per
 // plan.sections entry; each is judged like a region on its points.
+// `holes` holds one measurement per plan.holes entry (MeasureHoles).
 absl::StatusOr<CharacteristicsResult> ComputeCharacteristics(
     const ErrorMapResult& error_map, const ResolvedInspectionPlan& plan,
     std::size_t defect_count = 0, const CharacteristicsSettings& settings = {},
-    const CoverageResult* coverage = nullptr, const std::vector<SectionCut>& sections = {});
+    const CoverageResult* coverage = nullptr, const std::vector<SectionCut>& sections = {},
+    const std::vector<HoleMeasurement>& holes = {});
 
 }  // namespace surfinspect

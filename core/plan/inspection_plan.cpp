@@ -6,6 +6,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/distance/point_triangle.h"
+#include "core/plan/cad_holes.h"
 #include "core/types/status_macros.h"
 
 namespace surfinspect {
@@ -149,6 +150,60 @@ absl::Status CheckSections(const InspectionPlan& plan, const TriangleMesh& part,
   return absl::OkStatus();
 }
 
+// A hole's path names it as the JSON does: the k-th of its kind.
+std::string HolePath(const InspectionPlan& plan, const std::string& where, std::size_t k) {
+  std::size_t same = 0;
+  for (std::size_t i = 0; i < k; ++i) same += plan.holes[i].slot == plan.holes[k].slot;
+  return Index(where + (plan.holes[k].slot ? ".slots" : ".holes"), same);
+}
+
+absl::Status CheckHole(const PlanHole& h, const std::string& path) {
+  if (!h.position_mm.allFinite()) return Bad(path + ".position_mm", "not a finite number");
+  if (!h.axis.allFinite() || !(h.axis.norm() > 0))
+    return Bad(path + ".axis", "must be a finite non-zero vector");
+  const char* size = h.slot ? ".width_mm" : ".diameter_mm";
+  RETURN_IF_ERROR(CheckFinite(path + size, h.diameter_mm));
+  if (!(h.diameter_mm > 0)) return Bad(path + size, "must be > 0");
+  RETURN_IF_ERROR(CheckFinite(path + ".position_tolerance_mm", h.position_tolerance_mm));
+  if (!(h.position_tolerance_mm > 0)) return Bad(path + ".position_tolerance_mm", "must be > 0");
+  RETURN_IF_ERROR(CheckBand(path + (h.slot ? ".width_tolerance_mm" : ".diameter_tolerance_mm"),
+                            h.diameter_tolerance));
+  RETURN_IF_ERROR(CheckFinite(path + ".min_arc_deg", h.min_arc_deg));
+  if (!(h.min_arc_deg >= 0 && h.min_arc_deg <= 360))
+    return Bad(path + ".min_arc_deg", "must be in [0, 360]");
+  if (!h.slot) return absl::OkStatus();
+  RETURN_IF_ERROR(CheckFinite(path + ".length_mm", h.length_mm));
+  if (!(h.length_mm > h.diameter_mm)) return Bad(path + ".length_mm", "must be > width_mm");
+  RETURN_IF_ERROR(CheckBand(path + ".length_tolerance_mm", h.length_tolerance));
+  const Eigen::Vector3d a = h.axis.normalized();
+  if (!h.direction.allFinite() ||
+      !((h.direction - h.direction.dot(a) * a).norm() > 0.1 * h.direction.norm()))
+    return Bad(path + ".direction", "must be a finite vector across the axis");
+  return absl::OkStatus();
+}
+
+// Each hole must have a nominal one in the CAD: a hole the CAD lists
+// (core/plan/cad_holes.h) whose edge encloses the plan's position.
+absl::Status CheckHoles(const InspectionPlan& plan, const TriangleMesh& part,
+                        const std::string& where, std::set<std::string>& names) {
+  if (plan.holes.empty()) return absl::OkStatus();
+  const std::vector<CadHole> cad = ListHoles(part);
+  for (std::size_t k = 0; k < plan.holes.size(); ++k) {
+    const PlanHole& h = plan.holes[k];
+    const std::string path = HolePath(plan, where, k);
+    RETURN_IF_ERROR(CheckName(path + ".name", h.name, names));
+    RETURN_IF_ERROR(CheckHole(h, path));
+    bool near = false;
+    for (const CadHole& c : cad)
+      near |= (c.position_mm - h.position_mm).norm() <= 0.5 * c.diameter_mm;
+    if (!near)
+      return Bad(path + ".position_mm",
+                 absl::StrCat("no hole of the CAD there (", cad.size(),
+                              " found: boundary loops that are circles or slots)"));
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
 
 absl::Status ValidateInspectionPlan(const InspectionPlan& plan, const TriangleMesh& part,
@@ -189,6 +244,7 @@ absl::Status ValidateInspectionPlan(const InspectionPlan& plan, const TriangleMe
     if (p.min_coverage) RETURN_IF_ERROR(CheckFraction(path + ".min_coverage", *p.min_coverage));
   }
   RETURN_IF_ERROR(CheckSections(plan, part, where, names));
+  RETURN_IF_ERROR(CheckHoles(plan, part, where, names));
   if (plan.defects) {
     const std::string path = where + ".defects";
     const DefectRules& d = *plan.defects;

@@ -95,6 +95,30 @@ struct PlanSection {
   double allowed_fraction_outside = 0.0;               // in [0, 1]
 };
 
+// A hole's edge seen over less than this arc is not measured: a circle fitted
+// to less than half its edge is poorly conditioned in diameter and centre.
+inline constexpr double kDefaultMinArcDeg = 180;
+
+// A hole or a slot of the drawing (core/plan/holes.h), measured at its edge
+// on the scan. Nominal in the part frame: the centre in the plane of the
+// rim, the axis (unit after parsing; the side the sheet's scanned face looks
+// to), the diameter (a slot's width) and a slot's overall length and
+// length direction. Judged by its true position (2 x the radial deviation
+// of the centre, ISO 1101) and its size deviation(s).
+struct PlanHole {
+  std::string name;
+  bool slot = false;
+  Eigen::Vector3d position_mm = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  double diameter_mm = 0;                               // > 0; a slot's width
+  double length_mm = 0;                                 // slot: > diameter_mm
+  Eigen::Vector3d direction = Eigen::Vector3d::Zero();  // slot: unit after parsing, normal to axis
+  double position_tolerance_mm = 0.2;                   // true position zone diameter, > 0
+  ToleranceBand diameter_tolerance{-0.1, 0.1};          // of the diameter (a slot's width)
+  ToleranceBand length_tolerance{-0.2, 0.2};            // slot only
+  double min_arc_deg = kDefaultMinArcDeg;               // seen over less: not measured
+};
+
 struct DefectRules {
   double threshold_mm = 0.05;  // |robust local deviation| above this is defective; > 0
   double min_area_mm2 = 3.0;   // smaller patches are not reported; >= 0
@@ -122,6 +146,7 @@ struct InspectionPlan {
   std::vector<PlanRegion> regions;
   std::vector<ComparisonPoint> points;
   std::vector<PlanSection> sections;
+  std::vector<PlanHole> holes;         // holes, then slots, in plan order
   std::optional<DefectRules> defects;  // unset: no defect detection
 };
 

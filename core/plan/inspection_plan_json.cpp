@@ -199,6 +199,58 @@ absl::StatusOr<PlanSection> Section(const json& j, const std::string& path) {
   return s;
 }
 
+absl::StatusOr<Eigen::Vector3d> UnitVector(const json& j, const std::string& path) {
+  ASSIGN_OR_RETURN(auto v, Vector3(j, path));
+  if (!(v.norm() > 1e-12)) return Bad(path, "zero vector");
+  return Eigen::Vector3d(v.normalized());
+}
+
+// The keys a hole and a slot share; `size` is "diameter" or "width".
+absl::Status HoleCommon(const json& j, const std::string& path, const char* size, PlanHole& h) {
+  const std::string size_key = absl::StrCat(size, "_mm"),
+                    band_key = absl::StrCat(size, "_tolerance_mm");
+  for (const std::string& key :
+       {std::string("name"), std::string("position_mm"), std::string("axis"), size_key})
+    if (!j.contains(key)) return Bad(absl::StrCat(path, ".", key), "missing");
+  ASSIGN_OR_RETURN(h.name, String(j["name"], path + ".name"));
+  ASSIGN_OR_RETURN(h.position_mm, Vector3(j["position_mm"], path + ".position_mm"));
+  ASSIGN_OR_RETURN(h.axis, UnitVector(j["axis"], path + ".axis"));
+  ASSIGN_OR_RETURN(h.diameter_mm, Number(j[size_key], absl::StrCat(path, ".", size_key)));
+  RETURN_IF_ERROR(OptionalNumber(j, "position_tolerance_mm", path, h.position_tolerance_mm));
+  if (j.contains(band_key)) {
+    ASSIGN_OR_RETURN(h.diameter_tolerance, Band(j[band_key], absl::StrCat(path, ".", band_key)));
+  }
+  return OptionalNumber(j, "min_arc_deg", path, h.min_arc_deg);
+}
+
+absl::StatusOr<PlanHole> Hole(const json& j, const std::string& path) {
+  RETURN_IF_ERROR(CheckKeys(j, path,
+                            {"name", "position_mm", "axis", "diameter_mm", "position_tolerance_mm",
+                             "diameter_tolerance_mm", "min_arc_deg"}));
+  PlanHole h;
+  RETURN_IF_ERROR(HoleCommon(j, path, "diameter", h));
+  return h;
+}
+
+absl::StatusOr<PlanHole> Slot(const json& j, const std::string& path) {
+  RETURN_IF_ERROR(CheckKeys(
+      j, path,
+      {"name", "position_mm", "axis", "direction", "width_mm", "length_mm", "position_tolerance_mm",
+       "width_tolerance_mm", "length_tolerance_mm", "min_arc_deg"}));
+  PlanHole h;
+  h.slot = true;
+  RETURN_IF_ERROR(HoleCommon(j, path, "width", h));
+  for (const char* key : {"direction", "length_mm"})
+    if (!j.contains(key)) return Bad(absl::StrCat(path, ".", key), "missing");
+  ASSIGN_OR_RETURN(h.direction, UnitVector(j["direction"], path + ".direction"));
+  ASSIGN_OR_RETURN(h.length_mm, Number(j["length_mm"], path + ".length_mm"));
+  if (j.contains("length_tolerance_mm")) {
+    ASSIGN_OR_RETURN(h.length_tolerance,
+                     Band(j["length_tolerance_mm"], path + ".length_tolerance_mm"));
+  }
+  return h;
+}
+
 absl::StatusOr<DefectRules> Defects(const json& j, const std::string& path) {
   if (auto st = CheckKeys(j, path, {"threshold_mm", "min_area_mm2", "max_count"}); !st.ok())
     return st;
@@ -238,7 +290,7 @@ absl::StatusOr<InspectionPlan> ParseInspectionPlan(const json& j, const Triangle
   if (auto st = CheckKeys(j, where,
                           {"schema", "tolerance_mm", "allowed_fraction_outside", "min_coverage",
                            "coverage_distance_mm", "allow_not_measured", "regions", "points",
-                           "sections", "defects"});
+                           "sections", "holes", "slots", "defects"});
       !st.ok())
     return st;
   InspectionPlan plan;
@@ -269,6 +321,9 @@ absl::StatusOr<InspectionPlan> ParseInspectionPlan(const json& j, const Triangle
     RETURN_IF_ERROR(List(j["points"], where + ".points", Point, plan.points));
   if (j.contains("sections"))
     RETURN_IF_ERROR(List(j["sections"], where + ".sections", Section, plan.sections));
+  // Holes, then slots: ValidateInspectionPlan names plan.holes[k] by that order.
+  if (j.contains("holes")) RETURN_IF_ERROR(List(j["holes"], where + ".holes", Hole, plan.holes));
+  if (j.contains("slots")) RETURN_IF_ERROR(List(j["slots"], where + ".slots", Slot, plan.holes));
   if (j.contains("defects")) {
     ASSIGN_OR_RETURN(auto d, Defects(j["defects"], where + ".defects"));
     plan.defects = d;

@@ -78,7 +78,8 @@ bool PlanJudgesCoverage(const InspectionPlan& plan) {
 
 absl::StatusOr<PlanOutcome> EvaluatePlan(const ErrorMapResult& error_map, const PointCloud& cloud,
                                          const TriangleMesh& part, const InspectionPlan& plan,
-                                         int threads, const std::atomic<bool>* cancel) {
+                                         int threads, const std::atomic<bool>* cancel,
+                                         const std::vector<PlanView>& views) {
   ASSIGN_OR_RETURN(auto resolved, ResolveInspectionPlan(plan, part));
   PlanOutcome out;
   // The sampling spacing, estimated once for coverage and defects alike.
@@ -101,12 +102,13 @@ absl::StatusOr<PlanOutcome> EvaluatePlan(const ErrorMapResult& error_map, const 
     out.defects_run = true;
   }
   ASSIGN_OR_RETURN(out.sections, CutSections(error_map, part, resolved));
+  ASSIGN_OR_RETURN(auto holes, MeasureHoles(resolved.plan.holes, views, {}, cancel));
   CharacteristicsSettings cs;
   cs.threads = threads;
   ASSIGN_OR_RETURN(
       out.characteristics,
       ComputeCharacteristics(error_map, resolved, out.defects.defects.size(), cs,
-                             out.coverage_run ? &out.coverage : nullptr, out.sections));
+                             out.coverage_run ? &out.coverage : nullptr, out.sections, holes));
   return out;
 }
 

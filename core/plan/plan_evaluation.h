@@ -20,6 +20,7 @@
 #include "core/io/length_units.h"
 #include "core/plan/characteristics.h"
 #include "core/plan/defects.h"
+#include "core/plan/holes.h"
 #include "core/plan/inspection_plan.h"
 #include "core/types/point_cloud.h"
 #include "core/types/triangle_mesh.h"
@@ -74,11 +75,13 @@ struct PlanOutcome {
 bool PlanJudgesCoverage(const InspectionPlan& plan);
 
 // `cloud` is the cloud `error_map` was computed on (any frame), `part` the
-// mesh it was computed against. InvalidArgument (field named, "plan...")
+// mesh it was computed against. `views` are the organized views the cloud
+// was merged from, for holes and slots (core/plan/holes.h); without them a
+// plan's holes are not measured. InvalidArgument (field named, "plan...")
 // for a plan that does not fit the part; Cancelled when `cancel` is raised.
 absl::StatusOr<PlanOutcome> EvaluatePlan(const ErrorMapResult& error_map, const PointCloud& cloud,
                                          const TriangleMesh& part, const InspectionPlan& plan,
-                                         int threads = 0,
-                                         const std::atomic<bool>* cancel = nullptr);
+                                         int threads = 0, const std::atomic<bool>* cancel = nullptr,
+                                         const std::vector<PlanView>& views = {});
 
 }  // namespace surfinspect

@@ -9,40 +9,6 @@
 namespace surfinspect {
 namespace {
 
-using Vec2 = Eigen::Vector2d;  // (y, z) in the pillar's cross-section
-
-// Pillar cross-section: a hat channel. Top ridge half-width, height, wall
-// angle, flange width and bend radius, all mm; the numbers are those of a
-// typical stamped B-pillar reinforcement.
-constexpr double kTopHalfWidth = 30, kHeight = 60, kWallDeg = 75, kFlange = 30, kBendRadius = 6;
-constexpr int kBendSegments = 8;
-constexpr double kStepAlongMm = 5;  // extrusion step
-constexpr double kBowSagMm = 3;     // the ridge sags 3 mm towards the ends
-
-// Rounds the corners of a polyline with circular arcs of radius r.
-std::vector<Vec2> FilletPolyline(const std::vector<Vec2>& sharp, double r, int segments) {
-  std::vector<Vec2> out{sharp.front()};
-  for (std::size_t i = 1; i + 1 < sharp.size(); ++i) {
-    const Vec2 c = sharp[i];
-    const Vec2 u1 = (c - sharp[i - 1]).normalized(), u2 = (sharp[i + 1] - c).normalized();
-    const double cross = u1.x() * u2.y() - u1.y() * u2.x();
-    const double theta = std::acos(std::clamp(u1.dot(u2), -1.0, 1.0));  // turning angle
-    const double d = r * std::tan(theta / 2);
-    const Vec2 start = c - d * u1;
-    const Vec2 left(-u1.y(), u1.x());
-    const Vec2 centre = start + (cross > 0 ? r : -r) * left;
-    const double signed_theta = cross > 0 ? theta : -theta;
-    for (int k = 0; k <= segments; ++k) {
-      const double a = signed_theta * k / segments;
-      const Vec2 v = start - centre;
-      out.push_back(centre + Vec2(std::cos(a) * v.x() - std::sin(a) * v.y(),
-                                  std::sin(a) * v.x() + std::cos(a) * v.y()));
-    }
-  }
-  out.push_back(sharp.back());
-  return out;
-}
-
 void AddBox(TriangleMesh& m, const Eigen::Vector3f& lo, const Eigen::Vector3f& hi) {
   const auto base = static_cast<uint32_t>(m.vertices.size());
   for (int i = 0; i < 8; ++i)
@@ -69,11 +35,6 @@ Eigen::Isometry3d Perturb(std::mt19937_64& rng, double mm, double deg) {
   d.linear() = Eigen::AngleAxisd(deg * M_PI / 180, axis).toRotationMatrix();
   d.translation() = mm * dir;
   return d;
-}
-
-double RidgeZ(double x, double length) {
-  const double u = x / (0.5 * length);
-  return kHeight - kBowSagMm * u * u;
 }
 
 }  // namespace
@@ -103,32 +64,6 @@ void AddUvSphere(TriangleMesh& m, const Eigen::Vector3d& c, double r, int slices
     m.triangles.push_back({south, ring(stacks - 1, k + 1), ring(stacks - 1, k)});
 }
 
-TriangleMesh MakePillarMesh(double length_mm) {
-  const double run = kHeight / std::tan(kWallDeg * M_PI / 180);
-  const double a = kTopHalfWidth;
-  const std::vector<Vec2> sharp = {
-      {-(a + run + kFlange), 0}, {-(a + run), 0}, {-a, kHeight}, {a, kHeight}, {a + run, 0},
-      {a + run + kFlange, 0}};
-  const std::vector<Vec2> profile = FilletPolyline(sharp, kBendRadius, kBendSegments);
-  const int along = std::max(1, static_cast<int>(std::lround(length_mm / kStepAlongMm)));
-  const auto np = static_cast<uint32_t>(profile.size());
-  TriangleMesh m;
-  for (int j = 0; j <= along; ++j) {
-    const double x = -0.5 * length_mm + length_mm * j / along;
-    const double sag = kHeight - RidgeZ(x, length_mm);
-    for (const Vec2& p : profile) m.vertices.emplace_back(x, p.x(), p.y() - sag);
-  }
-  // (x step) x (profile tangent) points out of the material: +z on the ridge.
-  for (uint32_t j = 0; j < static_cast<uint32_t>(along); ++j)
-    for (uint32_t i = 0; i + 1 < np; ++i) {
-      const uint32_t v00 = j * np + i, v01 = (j + 1) * np + i, v10 = j * np + i + 1,
-                     v11 = (j + 1) * np + i + 1;
-      m.triangles.push_back({v00, v01, v10});
-      m.triangles.push_back({v10, v01, v11});
-    }
-  return m;
-}
-
 TriangleMesh MakeGaugeMesh() {
   // Stepped plate (x-normal step faces) and three spheres of different radii
   // at asymmetric spots: together they pin all six degrees of freedom.
@@ -143,7 +78,9 @@ TriangleMesh MakeGaugeMesh() {
 
 DemoCell MakeDemoCell(const DemoCellOptions& o) {
   DemoCell cell;
-  cell.part = MakePillarMesh(o.part_length_mm);
+  cell.part_length_mm = o.part_length_mm;
+  cell.features = DemoPillarFeatures();
+  cell.part = MakePillarMesh(o.part_length_mm, cell.features);
   cell.gauge = MakeGaugeMesh();
   cell.world_from_part = Pose({600, 100, 5}, 3.0);
   std::mt19937_64 rng(o.seed);
@@ -151,7 +88,7 @@ DemoCell MakeDemoCell(const DemoCellOptions& o) {
   const double tilt_deg[5][2] = {{12, -8}, {-10, 5}, {6, 10}, {-12, -6}, {10, 8}};
   for (int v = 0; v < 5; ++v) {
     const double x = xs[v] * o.part_length_mm;
-    const Eigen::Vector3d target_part(x, 0, RidgeZ(x, o.part_length_mm));
+    const Eigen::Vector3d target_part(x, 0, PillarRidgeZ(x, o.part_length_mm));
     const Eigen::Vector3d target = cell.world_from_part * target_part;
     const Eigen::Vector3d dir =
         (Eigen::AngleAxisd(tilt_deg[v][0] * M_PI / 180, Eigen::Vector3d::UnitX()) *
@@ -188,7 +125,7 @@ std::vector<DemoPart> MakeDemoParts(const DemoCell& cell, int count, uint64_t sc
     for (int d = 0; d < 3; ++d) {
       SurfaceDefect defect;
       const double x = ux(rng) * length;
-      defect.center_in_part = {x, uy(rng), RidgeZ(x, length)};
+      defect.center_in_part = {x, uy(rng), PillarRidgeZ(x, length)};
       defect.radius_mm = uradius(rng);
       defect.depth_mm = (d == 2 ? -1 : 1) * udepth(rng);  // two dents and a bump
       part.defects.push_back(defect);
@@ -214,7 +151,11 @@ absl::StatusOr<SimulatedScan> SimulateDemoPartScan(const DemoCell& cell, const D
   ScanOptions opt = scan;
   opt.defects.insert(opt.defects.end(), part.defects.begin(), part.defects.end());
   opt.seed = scan.seed * 7919 + part.number * 100 + v;
-  return SimulateScan(cell.part, cell.world_from_part, vp.world_from_sensor, cell.intrinsics, opt);
+  if (!part.manufactured)
+    return SimulateScan(cell.part, cell.world_from_part, vp.world_from_sensor, cell.intrinsics,
+                        opt);
+  const TriangleMesh made = MakePillarMesh(cell.part_length_mm, *part.manufactured);
+  return SimulateScan(made, cell.world_from_part, vp.world_from_sensor, cell.intrinsics, opt);
 }
 
 }  // namespace surfinspect

@@ -11,10 +11,12 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "core/simulation/pillar.h"
 #include "core/simulation/scan_simulator.h"
 #include "core/types/triangle_mesh.h"
 
@@ -28,7 +30,9 @@ struct DemoViewpoint {
 };
 
 struct DemoCell {
-  TriangleMesh part;  // part frame, mm
+  TriangleMesh part;  // part frame, mm: MakePillarMesh(part_length_mm, features)
+  double part_length_mm = 300;
+  PillarFeatures features;  // the CAD's holes
   Eigen::Isometry3d world_from_part;
   TriangleMesh gauge;  // gauge frame, mm
   std::vector<DemoViewpoint> viewpoints;
@@ -44,9 +48,6 @@ struct DemoCellOptions {
 
 DemoCell MakeDemoCell(const DemoCellOptions& options = {});
 
-// The pillar part alone, e.g. for tests (hat channel along +x, top ridge at
-// the highest z, centred on the origin).
-TriangleMesh MakePillarMesh(double length_mm = 300.0);
 // A UV sphere of radius r (mm) about c: `slices` around the z axis and
 // `stacks` from pole to pole; vertices on the sphere, outward CCW normals.
 // Its facets lie inside the sphere by at most r (1 - cos(pi / min(slices, 2 stacks)))
@@ -60,6 +61,9 @@ struct DemoPart {
   int number = 1;                      // 1-based
   std::string part_id;                 // "part-001", ...
   std::vector<SurfaceDefect> defects;  // two dents and a bump on the ridge
+  // The part as made where it differs from the CAD (shifted or resized
+  // holes, an offset trim edge); unset: as the CAD.
+  std::optional<PillarFeatures> manufactured;
 };
 
 // Parts 1..count with their defects, drawn from `scan_seed` (the seed of the

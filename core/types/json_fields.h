@@ -52,7 +52,10 @@ class JsonWriter {
   void operator()(const char* key, const std::optional<double>& v) {
     if (v) out[key] = JsonNumber(*v);
   }
-  void operator()(const char* key, const Eigen::Vector3d& v) { out[key] = {v.x(), v.y(), v.z()}; }
+  // A vector that does not exist (NaN) is null, like a number.
+  void operator()(const char* key, const Eigen::Vector3d& v) {
+    out[key] = v.allFinite() ? nlohmann::json{v.x(), v.y(), v.z()} : nlohmann::json(nullptr);
+  }
   template <typename T>
   void operator()(const char* key, const T& v) {
     out[key] = v;
@@ -159,6 +162,10 @@ class JsonReader {
   void operator()(const char* key, Eigen::Vector3d& v) {
     const nlohmann::json* x = Get(key);
     if (!x) return;
+    if (x->is_null()) {
+      v = Eigen::Vector3d::Constant(NAN);
+      return;
+    }
     const bool ok =
         x->is_array() && x->size() == 3 &&
         std::all_of(x->begin(), x->end(), [](const nlohmann::json& c) { return c.is_number(); });

@@ -1,0 +1,154 @@
+#include "core/plan/cad_holes.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <optional>
+
+#include "core/plan/profile_fit.h"
+
+namespace surfinspect {
+namespace {
+
+// Boundary edges directed as their one triangle walks them, chained into
+// closed loops of vertex ids (a loop that does not close is dropped).
+std::vector<std::vector<uint32_t>> BoundaryLoops(const TriangleMesh& mesh) {
+  const std::vector<EdgeUse> uses = SortedEdgeUses(mesh);
+  std::multimap<uint32_t, uint32_t> next;  // from -> to
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i + 1;
+    while (j < uses.size() && uses[j].edge == uses[i].edge) ++j;
+    if (j == i + 1) {
+      const Triangle& t = mesh.triangles[uses[i].triangle];
+      const auto lo = static_cast<uint32_t>(uses[i].edge >> 32);
+      const auto hi = static_cast<uint32_t>(uses[i].edge);
+      for (int k = 0; k < 3; ++k)
+        if ((t[k] == lo && t[(k + 1) % 3] == hi) || (t[k] == hi && t[(k + 1) % 3] == lo))
+          next.emplace(t[k], t[(k + 1) % 3]);
+    }
+    i = j;
+  }
+  std::vector<std::vector<uint32_t>> loops;
+  while (!next.empty()) {
+    const uint32_t first = next.begin()->first;
+    std::vector<uint32_t> loop{first};
+    uint32_t at = first;
+    bool closed = false;
+    while (true) {
+      const auto it = next.find(at);
+      if (it == next.end()) break;
+      at = it->second;
+      next.erase(it);
+      if (at == first) {
+        closed = true;
+        break;
+      }
+      loop.push_back(at);
+    }
+    if (closed && loop.size() >= 3) loops.push_back(std::move(loop));
+  }
+  return loops;
+}
+
+// Per vertex, the sum of its triangles' area-weighted normals: over a
+// loop's vertices, the side the hole's face looks to.
+std::vector<Eigen::Vector3d> VertexSides(const TriangleMesh& mesh) {
+  std::vector<Eigen::Vector3d> side(mesh.vertices.size(), Eigen::Vector3d::Zero());
+  for (const Triangle& t : mesh.triangles) {
+    const Eigen::Vector3d a = mesh.vertices[t[0]].cast<double>(),
+                          b = mesh.vertices[t[1]].cast<double>(),
+                          c = mesh.vertices[t[2]].cast<double>();
+    const Eigen::Vector3d n = (b - a).cross(c - a);
+    for (uint32_t v : t) side[v] += n;
+  }
+  return side;
+}
+
+std::optional<CadHole> HoleOfLoop(const TriangleMesh& mesh,
+                                  const std::vector<Eigen::Vector3d>& sides,
+                                  const std::vector<uint32_t>& loop, const CadHoleSettings& s) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (uint32_t v : loop) mean += mesh.vertices[v].cast<double>();
+  mean /= double(loop.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (uint32_t v : loop) {
+    const Eigen::Vector3d d = mesh.vertices[v].cast<double>() - mean;
+    cov += d * d.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  Eigen::Vector3d axis = eig.eigenvectors().col(0);
+  Eigen::Vector3d side = Eigen::Vector3d::Zero();
+  for (uint32_t v : loop) side += sides[v];
+  if (axis.dot(side) < 0) axis = -axis;
+  const PlaneFrame frame = MakePlaneFrame(mean, axis, eig.eigenvectors().col(2));
+  std::vector<Eigen::Vector2d> pts;
+  double lo = INFINITY, hi = -INFINITY, size = 0;
+  for (uint32_t v : loop) {
+    const Eigen::Vector3d p = mesh.vertices[v].cast<double>();
+    pts.push_back(frame.To2d(p));
+    lo = std::min(lo, (p - mean).dot(axis));
+    hi = std::max(hi, (p - mean).dot(axis));
+    size = std::max(size, 2 * pts.back().norm());
+  }
+  if (!(size > 0) || size > s.max_size_mm || hi - lo > s.max_flatness_ratio * size)
+    return std::nullopt;
+  CadHole hole;
+  hole.axis = axis;
+  hole.flatness_mm = hi - lo;
+  hole.vertices = loop.size();
+  auto fit = FitCircle2d(pts);
+  if (!fit.ok() || fit->inliers < pts.size() || fit->form > s.max_form_ratio * fit->diameter()) {
+    ProfileFit start;  // the principal axes: e1 along the longest extent
+    double umax = 0, vmax = 0;
+    for (const auto& q : pts)
+      umax = std::max(umax, std::abs(q.x())), vmax = std::max(vmax, std::abs(q.y()));
+    start.radius = vmax;
+    start.half_length = std::max(umax - vmax, 0.0);
+    fit = FitSlot2d(pts, start);
+    if (!fit.ok() || fit->inliers < pts.size() || fit->form > s.max_form_ratio * fit->diameter())
+      return std::nullopt;
+    hole.slot = true;
+    hole.length_mm = fit->length();
+    hole.direction = (fit->direction.x() * frame.e1 + fit->direction.y() * frame.e2).normalized();
+  }
+  hole.position_mm = frame.To3d(fit->centre);
+  hole.diameter_mm = fit->diameter();
+  hole.form_mm = fit->form;
+  return hole;
+}
+
+}  // namespace
+
+PlaneFrame MakePlaneFrame(const Eigen::Vector3d& origin, const Eigen::Vector3d& axis,
+                          const Eigen::Vector3d& along) {
+  PlaneFrame f;
+  f.origin = origin;
+  f.axis = axis.normalized();
+  Eigen::Vector3d e1 = along - along.dot(f.axis) * f.axis;
+  if (!(e1.norm() > 1e-6 * std::max(along.norm(), 1e-300))) {
+    Eigen::Index least = 0;
+    f.axis.cwiseAbs().minCoeff(&least);
+    const Eigen::Vector3d w = Eigen::Vector3d::Unit(least);
+    e1 = w - w.dot(f.axis) * f.axis;
+  }
+  f.e1 = e1.normalized();
+  f.e2 = f.axis.cross(f.e1);
+  return f;
+}
+
+std::vector<CadHole> ListHoles(const TriangleMesh& mesh, const CadHoleSettings& settings) {
+  std::vector<CadHole> holes;
+  const auto loops = BoundaryLoops(mesh);
+  if (loops.empty()) return holes;
+  const std::vector<Eigen::Vector3d> sides = VertexSides(mesh);
+  for (const auto& loop : loops)
+    if (auto hole = HoleOfLoop(mesh, sides, loop, settings)) holes.push_back(*hole);
+  std::sort(holes.begin(), holes.end(), [](const CadHole& a, const CadHole& b) {
+    return std::lexicographical_compare(a.position_mm.data(), a.position_mm.data() + 3,
+                                        b.position_mm.data(), b.position_mm.data() + 3);
+  });
+  return holes;
+}
+
+}  // namespace surfinspect
