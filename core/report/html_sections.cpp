@@ -1,10 +1,10 @@
 #include "core/report/html_sections.h"
 
 #include <algorithm>
-#include <cmath>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_replace.h"
 #include "core/report/html_escape.h"
 #include "core/report/report_content.h"
 
@@ -37,16 +37,6 @@ std::string ValueRow(const std::string& label, const std::string& key, const jso
                       "</td></tr>\n");
 }
 
-// "+-t" for a symmetric band, "lower..upper" otherwise (mm).
-std::string Band(const ToleranceBand& tolerance) {
-  const double lo = tolerance.lower_mm, hi = tolerance.upper_mm;
-  if (lo == -hi) return absl::StrFormat("\u00b1%g", hi);
-  auto bound = [](double v) {
-    return std::isnan(v) ? std::string("\u2013") : absl::StrFormat("%g", v);
-  };
-  return absl::StrCat(bound(lo), "..", bound(hi));
-}
-
 std::string VerdictCell(const std::string& v) {
   const std::string s = v.empty() ? "?" : v;
   const char* cls = s == "pass" ? "pass" : s == "not_measured" ? "unmeasured" : "fail";
@@ -77,22 +67,24 @@ std::string VerdictBanner(const InspectionReport& report, const HtmlReportContex
   return out + "</header>\n";
 }
 
+// The printed reports' table (core/report/report_content.h), cell for
+// cell; a cell's lines become line breaks.
 std::string CharacteristicsTable(const InspectionReport& report) {
   std::vector<ReportCharacteristic> rows = report.characteristics;
   std::stable_partition(rows.begin(), rows.end(),
                         [](const ReportCharacteristic& c) { return !c.passed(); });
-  std::string out =
-      "<table id=\"characteristics\"><thead><tr><th>name</th><th>type</th><th>verdict</th>"
-      "<th>band mm</th><th>value/mean mm</th><th>min mm</th><th>max mm</th><th>within</th>"
-      "<th>points</th><th>coverage</th></tr></thead><tbody>\n";
+  std::string out = "<table id=\"characteristics\"><thead><tr>";
+  for (const std::string& h : CharacteristicHeader()) absl::StrAppend(&out, "<th>", h, "</th>");
+  out += "</tr></thead><tbody>\n";
   for (const ReportCharacteristic& c : rows) {
-    const double value = c.is_point() && !std::isnan(c.value_mm) ? c.value_mm : c.mean_mm;
-    const double within = c.fraction_within;
-    absl::StrAppend(&out, "<tr title=\"", HtmlEscape(c.reason), "\">", Td(c.name), Td(c.type),
-                    VerdictCell(c.verdict), Td(Band(c.tolerance)), Td(JsonNumber(value)),
-                    Td(JsonNumber(c.min_mm)), Td(JsonNumber(c.max_mm)),
-                    Td(std::isnan(within) ? json() : json(absl::StrFormat("%.2f%%", 100 * within))),
-                    Td(c.points), Td(CoverageText(c)), "</tr>\n");
+    absl::StrAppend(&out, "<tr title=\"", HtmlEscape(c.reason), "\">");
+    const std::vector<std::string> cells = CharacteristicRow(c);
+    for (std::size_t k = 0; k < cells.size(); ++k) {
+      const std::string text = absl::StrReplaceAll(HtmlEscape(cells[k]), {{"\n", "<br>"}});
+      absl::StrAppend(
+          &out, k == kVerdictColumn ? VerdictCell(c.verdict) : absl::StrCat("<td>", text, "</td>"));
+    }
+    out += "</tr>\n";
   }
   return out + "</tbody></table>\n";
 }

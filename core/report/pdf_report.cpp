@@ -306,8 +306,9 @@ absl::StatusOr<std::string> RenderPdfReport(const PdfReportInput& in) {
   DrawLegend(p.canvas, c, legend_x, p.y + 30, p.y + map_h - 30);
   p.y += map_h + 8;
   DrawStatistics(p, c);
+  // One width per column of CharacteristicHeader(), kWidth in all.
   DrawTable(p, "Characteristics (failed first)", c.characteristics,
-            {118, 42, 36, 78, 52, 45, 45, 47, 52});
+            {88, 32, 40, 78, 78, 40, 40, 42, 35, 42});
   DrawTable(p, "Defects", c.defects, {30, 32, 118, 50, 50, 50, 45, 140});
   DrawSections(p, *in.report, c);
   return p.canvas.Finish();

@@ -14,6 +14,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "core/io/atomic_file.h"
+#include "core/report/report_content.h"
 #include "core/types/status_macros.h"
 
 namespace surfinspect {
@@ -48,63 +49,130 @@ pugi::xml_node WithId(pugi::xml_node parent, const char* name, int id) {
   return node;
 }
 
-// One report characteristic, read and checked.
-struct Characteristic {
-  std::string name, type, verdict, reason;
-  double lower = 0, upper = 0;
-  bool has_values = false;  // points > 0: min/max (and value for points) exist
-  double min_mm = 0, max_mm = 0, value_mm = 0;
-  // A section is a surface profile of its slab here: QIF's LineProfile
-  // needs the plane's normal, which the report does not carry yet.
-  const char* qif_kind() const { return type == "point" ? "PointProfile" : "SurfaceProfile"; }
+// One QIF characteristic. A surface, region, section or point is one; a
+// hole is two (its diameter and its position) and a slot three (width,
+// length, position), each with its own band and status, so that a quality
+// system sees which of them failed.
+struct QifCharacteristic {
+  enum class Family { kProfile, kSize, kPosition };
+  Family family = Family::kProfile;
+  std::string kind;             // the QIF elements' prefix: "SurfaceProfile", "Diameter", ...
+  std::string name;             // the report's name; a hole's parts add " diameter" etc.
+  std::string status;           // PASS, FAIL or INDETERMINATE
+  std::string description;      // the report's reason
+  double lower = 0, upper = 0;  // profile and size: the band; position: upper = the zone
+  double target = NAN;          // size: the nominal, known when measured
+  bool has_values = false;
+  double value = 0, worst_positive = 0, worst_negative = 0;  // the worst: profiles only
+  int size_index = -1;  // position: the index of its hole's size characteristic
 };
 
-absl::StatusOr<Characteristic> ReadCharacteristic(const ReportCharacteristic& c, std::size_t k) {
-  const std::string where = absl::StrCat("report.characteristics[", k, "]");
-  Characteristic out;
-  out.name = c.name;
-  out.type = c.type;
-  out.verdict = c.verdict;
-  out.reason = c.reason;
-  out.lower = c.tolerance.lower_mm;
-  out.upper = c.tolerance.upper_mm;
-  out.has_values = c.points > 0 && std::isfinite(c.min_mm);
-  if (out.has_values) {
-    out.min_mm = c.min_mm;
-    out.max_mm = c.max_mm;
-    if (out.type == "point") out.value_mm = c.value_mm;
-    if (!std::isfinite(out.max_mm) || !std::isfinite(out.value_mm))
-      return absl::InvalidArgumentError(absl::StrCat(where, ": points without values"));
-  }
-  if (!std::isfinite(out.lower) || !std::isfinite(out.upper))
-    return absl::InvalidArgumentError(absl::StrCat(where, ".tolerance_mm: missing"));
-  if (out.type != "surface" && out.type != "region" && out.type != "point" && out.type != "section")
-    return absl::InvalidArgumentError(absl::StrCat(where, ".type: unknown \"", out.type, "\""));
-  if (out.verdict != "pass" && out.verdict != "fail" && out.verdict != "not_measured")
-    return absl::InvalidArgumentError(absl::StrCat(where, ".verdict: not pass/fail/not_measured"));
-  return out;
+std::string Upper(const std::string& verdict) { return verdict == "pass" ? "PASS" : "FAIL"; }
+
+// A characteristic's status; QIF's CharacteristicStatusEnum has no "not
+// measured", and INDETERMINATE is what a characteristic seen over too little
+// of its area is (Characteristics.xsd).
+std::string CharacteristicStatus(const std::string& verdict) {
+  return verdict == "not_measured" ? "INDETERMINATE" : Upper(verdict);
 }
 
-absl::StatusOr<std::vector<Characteristic>> ReadCharacteristics(const InspectionReport& report) {
-  std::vector<Characteristic> out;
-  for (std::size_t k = 0; k < report.characteristics.size(); ++k) {
-    ASSIGN_OR_RETURN(auto c, ReadCharacteristic(report.characteristics[k], k));
-    out.push_back(std::move(c));
+// A surface, region or section is a surface profile of its points (a
+// section's slab too: QIF's LineProfile needs the plane's normal, which the
+// report does not carry); a comparison point is a point profile.
+absl::Status AddProfile(const ReportCharacteristic& c, const std::string& where,
+                        std::vector<QifCharacteristic>& out) {
+  QifCharacteristic q;
+  q.kind = c.is_point() ? "PointProfile" : "SurfaceProfile";
+  q.name = c.name;
+  q.status = CharacteristicStatus(c.verdict);
+  q.description = c.reason;
+  q.lower = c.tolerance.lower_mm;
+  q.upper = c.tolerance.upper_mm;
+  q.has_values = c.points > 0 && std::isfinite(c.min_mm);
+  if (q.has_values) {
+    q.worst_negative = c.min_mm;
+    q.worst_positive = c.max_mm;
+    // A surface profile's value is the zone width 2 max(|min|, |max|).
+    q.value = c.is_point() ? c.value_mm : 2.0 * std::max(std::abs(c.min_mm), std::abs(c.max_mm));
+    if (!std::isfinite(q.worst_positive) || !std::isfinite(q.value))
+      return absl::InvalidArgumentError(absl::StrCat(where, ": points without values"));
   }
+  out.push_back(std::move(q));
+  return absl::OkStatus();
+}
+
+// A size of a hole (diameter, a slot's width or length) against its band.
+QifCharacteristic Size(const ReportCharacteristic& c, const char* kind, const char* what,
+                       const ToleranceBand& band, double measured_mm, double deviation_mm,
+                       const std::string& verdict) {
+  QifCharacteristic q;
+  q.family = QifCharacteristic::Family::kSize;
+  q.kind = kind;
+  q.name = absl::StrCat(c.name, " ", what);
+  q.status = CharacteristicStatus(verdict);
+  q.description = c.reason;
+  q.lower = band.lower_mm;
+  q.upper = band.upper_mm;
+  q.has_values = c.measured() && std::isfinite(measured_mm) && std::isfinite(deviation_mm);
+  if (q.has_values) {
+    q.value = measured_mm;
+    // The plan's nominal, without the subtraction's last-bit error.
+    q.target = std::round((measured_mm - deviation_mm) * 1e9) / 1e9;
+  }
+  return q;
+}
+
+// A hole: its size(s), then its true position against the diametral zone.
+absl::Status AddHole(const ReportCharacteristic& c, const std::string& where,
+                     std::vector<QifCharacteristic>& out) {
+  const bool slot = c.type == "slot";
+  if (!(c.position_tolerance_mm > 0))
+    return absl::InvalidArgumentError(absl::StrCat(where, ".position_tolerance_mm: missing"));
+  if (slot && !(c.length_tolerance.lower_mm <= c.length_tolerance.upper_mm))
+    return absl::InvalidArgumentError(absl::StrCat(where, ".length_tolerance_mm: missing"));
+  const HoleVerdicts v = HoleVerdictsOf(c);
+  const int size_index = static_cast<int>(out.size());
+  out.push_back(Size(c, slot ? "Width" : "Diameter", slot ? "width" : "diameter", c.tolerance,
+                     c.measured_diameter_mm, c.diameter_deviation_mm, v.size));
+  if (slot)
+    out.push_back(Size(c, "Length", "length", c.length_tolerance, c.measured_length_mm,
+                       c.length_deviation_mm, v.length));
+  QifCharacteristic q;
+  q.family = QifCharacteristic::Family::kPosition;
+  q.kind = "Position";
+  q.name = absl::StrCat(c.name, " position");
+  q.status = CharacteristicStatus(v.position);
+  q.description = c.reason;
+  q.upper = c.position_tolerance_mm;
+  q.has_values = c.measured() && std::isfinite(c.true_position_mm);
+  q.value = c.true_position_mm;
+  q.size_index = size_index;
+  out.push_back(std::move(q));
+  return absl::OkStatus();
+}
+
+absl::Status AddCharacteristic(const ReportCharacteristic& c, std::size_t k,
+                               std::vector<QifCharacteristic>& out) {
+  const std::string where = absl::StrCat("report.characteristics[", k, "]");
+  if (!std::isfinite(c.tolerance.lower_mm) || !std::isfinite(c.tolerance.upper_mm))
+    return absl::InvalidArgumentError(absl::StrCat(where, ".tolerance_mm: missing"));
+  if (c.verdict != "pass" && c.verdict != "fail" && c.verdict != "not_measured")
+    return absl::InvalidArgumentError(absl::StrCat(where, ".verdict: not pass/fail/not_measured"));
+  if (c.is_hole()) return AddHole(c, where, out);
+  if (c.type != "surface" && c.type != "region" && c.type != "point" && c.type != "section")
+    return absl::InvalidArgumentError(absl::StrCat(where, ".type: unknown \"", c.type, "\""));
+  return AddProfile(c, where, out);
+}
+
+absl::StatusOr<std::vector<QifCharacteristic>> ReadCharacteristics(const InspectionReport& report) {
+  std::vector<QifCharacteristic> out;
+  for (std::size_t k = 0; k < report.characteristics.size(); ++k)
+    RETURN_IF_ERROR(AddCharacteristic(report.characteristics[k], k, out));
   return out;
 }
 
 std::string ModelOf(const QifContext& ctx) {
   return ctx.part_model.empty() ? absl::StrCat("part of cell ", ctx.cell) : ctx.part_model;
-}
-
-const char* Upper(const std::string& verdict) { return verdict == "pass" ? "PASS" : "FAIL"; }
-
-// A characteristic's status; QIF's CharacteristicStatusEnum has no "not
-// measured", and INDETERMINATE is what a characteristic seen over too little
-// of its area is (Characteristics.xsd).
-const char* CharacteristicStatus(const std::string& verdict) {
-  return verdict == "not_measured" ? "INDETERMINATE" : Upper(verdict);
 }
 
 void AddPreamble(pugi::xml_node doc, const QifContext& ctx) {
@@ -135,7 +203,34 @@ void AddPreamble(pugi::xml_node doc, const QifContext& ctx) {
   if (!ctx.part_model.empty()) Text(part, "ModelNumber", ctx.part_model);
 }
 
-void AddCharacteristics(pugi::xml_node doc, const std::vector<Characteristic>& cs,
+int IdOf(std::size_t k) { return kFirstCharacteristicId + 4 * static_cast<int>(k); }
+
+// The definition's tolerance. A profile's zone width, with an unequal
+// band's upper limit as OuterDisposition (the XSD: "the upper tolerance
+// limit when the tolerance zone is expressed as a bi-directional
+// tolerance"); a size's band as signed deviations (DefinedAsLimit false); a
+// position's zone diameter, regardless of feature size, circular in the
+// hole's plane (the report measures the centre in one plane).
+void AddTolerance(pugi::xml_node def, const QifCharacteristic& c) {
+  using Family = QifCharacteristic::Family;
+  if (c.family == Family::kProfile) {
+    Text(def, "ToleranceValue", Num(c.upper - c.lower));
+    if (c.lower != -c.upper) Text(def, "OuterDisposition", Num(c.upper));
+  } else if (c.family == Family::kSize) {
+    pugi::xml_node tol = def.append_child("Tolerance");
+    Text(tol, "MaxValue", Num(c.upper));
+    Text(tol, "MinValue", Num(c.lower));
+    Text(tol, "DefinedAsLimit", "false");
+  } else {
+    Text(def, "ToleranceValue", Num(c.upper));
+    Text(def, "MaterialCondition", "REGARDLESS");
+    Text(def, "SizeCharacteristicDefinitionId", std::to_string(IdOf(c.size_index)));
+    Text(def.append_child("ZoneShape").append_child("DiametricalZone"), "Dimensionality",
+         "TWODIMENSIONAL");
+  }
+}
+
+void AddCharacteristics(pugi::xml_node doc, const std::vector<QifCharacteristic>& cs,
                         const std::string& model) {
   pugi::xml_node root = doc.append_child("Characteristics");
   Text(root, "FormalStandardId", std::to_string(kStandardId));
@@ -143,16 +238,14 @@ void AddCharacteristics(pugi::xml_node doc, const std::vector<Characteristic>& c
   pugi::xml_node noms = Counted(root, "CharacteristicNominals", cs.size());
   pugi::xml_node items = Counted(root, "CharacteristicItems", cs.size());
   for (std::size_t k = 0; k < cs.size(); ++k) {
-    const Characteristic& c = cs[k];
-    const int id = kFirstCharacteristicId + 4 * static_cast<int>(k);
-    const std::string kind = c.qif_kind();
-    pugi::xml_node def = WithId(defs, (kind + "CharacteristicDefinition").c_str(), id);
-    Text(def, "ToleranceValue", Num(c.upper - c.lower));
-    if (c.lower != -c.upper) Text(def, "OuterDisposition", Num(c.upper));
-    pugi::xml_node nom = WithId(noms, (kind + "CharacteristicNominal").c_str(), id + 1);
+    const QifCharacteristic& c = cs[k];
+    const int id = IdOf(k);
+    AddTolerance(WithId(defs, (c.kind + "CharacteristicDefinition").c_str(), id), c);
+    pugi::xml_node nom = WithId(noms, (c.kind + "CharacteristicNominal").c_str(), id + 1);
     Text(nom, "CharacteristicDefinitionId", std::to_string(id));
     Text(nom, "Name", c.name);
-    pugi::xml_node item = WithId(items, (kind + "CharacteristicItem").c_str(), id + 2);
+    if (std::isfinite(c.target)) Text(nom, "TargetValue", Num(c.target));
+    pugi::xml_node item = WithId(items, (c.kind + "CharacteristicItem").c_str(), id + 2);
     Text(item, "Name", c.name);
     pugi::xml_node designator = item.append_child("CharacteristicDesignator");
     Text(designator, "Designator", c.name);
@@ -161,23 +254,21 @@ void AddCharacteristics(pugi::xml_node doc, const std::vector<Characteristic>& c
   }
 }
 
-void AddMeasurement(pugi::xml_node list, const Characteristic& c, int id) {
-  pugi::xml_node m =
-      WithId(list, (std::string(c.qif_kind()) + "CharacteristicMeasurement").c_str(), id + 3);
-  if (!c.reason.empty()) Text(m, "Description", c.reason);
-  Text(m.append_child("Status"), "CharacteristicStatusEnum", CharacteristicStatus(c.verdict));
+void AddMeasurement(pugi::xml_node list, const QifCharacteristic& c, int id) {
+  pugi::xml_node m = WithId(list, (c.kind + "CharacteristicMeasurement").c_str(), id + 3);
+  if (!c.description.empty()) Text(m, "Description", c.description);
+  Text(m.append_child("Status"), "CharacteristicStatusEnum", c.status);
   Text(m, "CharacteristicItemId", std::to_string(id + 2));
   Text(m, "ActualComponentId", std::to_string(kComponentId));
   Text(Counted(m, "MeasurementDeviceIds", 1), "Id", std::to_string(kDeviceId));
   if (!c.has_values) return;
-  const double value =
-      c.type == "point" ? c.value_mm : 2.0 * std::max(std::abs(c.min_mm), std::abs(c.max_mm));
-  Text(m, "Value", Num(value));
-  Text(m, "WorstPositiveDeviation", Num(c.max_mm));
-  Text(m, "WorstNegativeDeviation", Num(c.min_mm));
+  Text(m, "Value", Num(c.value));
+  if (c.family != QifCharacteristic::Family::kProfile) return;
+  Text(m, "WorstPositiveDeviation", Num(c.worst_positive));
+  Text(m, "WorstNegativeDeviation", Num(c.worst_negative));
 }
 
-void AddResults(pugi::xml_node doc, const std::vector<Characteristic>& cs,
+void AddResults(pugi::xml_node doc, const std::vector<QifCharacteristic>& cs,
                 const std::string& verdict, const QifContext& ctx) {
   pugi::xml_node results = doc.append_child("Results");
   pugi::xml_node mr =
@@ -198,8 +289,7 @@ void AddResults(pugi::xml_node doc, const std::vector<Characteristic>& cs,
                     ctx.points_count, " points)"));
   pugi::xml_node list =
       Counted(mr.append_child("MeasuredCharacteristics"), "CharacteristicMeasurements", cs.size());
-  for (std::size_t k = 0; k < cs.size(); ++k)
-    AddMeasurement(list, cs[k], kFirstCharacteristicId + 4 * static_cast<int>(k));
+  for (std::size_t k = 0; k < cs.size(); ++k) AddMeasurement(list, cs[k], IdOf(k));
   Text(mr.append_child("InspectionStatus"), "InspectionStatusEnum", Upper(verdict));
   Text(Counted(mr, "ActualComponentIds", 1), "Id", std::to_string(kComponentId));
   pugi::xml_node component =
@@ -227,7 +317,7 @@ absl::StatusOr<std::string> QifResultsXml(const InspectionReport& report, const 
   pugi::xml_node doc = xml.append_child("QIFDocument");
   doc.append_attribute("xmlns").set_value("http://qifstandards.org/xsd/qif3");
   doc.append_attribute("versionQIF").set_value("3.0.0");
-  doc.append_attribute("idMax").set_value(kFirstCharacteristicId + 4 * static_cast<int>(cs.size()));
+  doc.append_attribute("idMax").set_value(IdOf(cs.size()));
   AddPreamble(doc, ctx);
   AddCharacteristics(doc, cs, ModelOf(ctx));
   AddResults(doc, cs, verdict, ctx);

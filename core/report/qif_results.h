@@ -9,27 +9,41 @@
 //     ActualComponent: this part, SerialNumber = the part id.
 //   - MeasurementResources/MeasurementDevice: the cell (Name) and its sensor
 //     (Description).
-//   - One characteristic per report characteristic, in report order: the
-//     surface and every region as a SurfaceProfileCharacteristic, every
-//     comparison point as a PointProfileCharacteristic (the QIF type whose
-//     Value is a signed deviation at one location). Definition, nominal, item
-//     and measurement ids are 10 + 4k .. 13 + 4k for the k-th characteristic,
-//     and each item's CharacteristicDesignator carries the name and a
-//     name-based UUID, so the same plan gives the same ids in every part.
-//   - Tolerance: ToleranceValue = upper - lower (the zone width); an
-//     unequal band adds OuterDisposition = upper (the XSD: "the upper
-//     tolerance limit when the tolerance zone is expressed as a
-//     bi-directional tolerance").
+//   - Characteristics in report order: the surface, every region and
+//     every section as a SurfaceProfileCharacteristic, every comparison
+//     point as a PointProfileCharacteristic (the QIF type whose Value is a
+//     signed deviation at one location); a hole as two, a
+//     DiameterCharacteristic and a PositionCharacteristic named "<name>
+//     diameter" and "<name> position"; a slot as three, Width, Length and
+//     Position ("<name> width", "<name> length", "<name> position").
+//     Definition, nominal, item and measurement ids are 10 + 4k .. 13 + 4k
+//     for the k-th QIF characteristic, and each item's
+//     CharacteristicDesignator carries the name and a name-based UUID, so
+//     the same plan gives the same ids in every part.
+//   - Tolerance of a profile: ToleranceValue = upper - lower (the zone
+//     width); an unequal band adds OuterDisposition = upper (the XSD: "the
+//     upper tolerance limit when the tolerance zone is expressed as a
+//     bi-directional tolerance"). Of a size: Tolerance with MaxValue =
+//     upper, MinValue = lower, DefinedAsLimit false (signed deviations from
+//     the nominal). Of a position: ToleranceValue = the zone's diameter,
+//     MaterialCondition REGARDLESS, a two-dimensional DiametricalZone (the
+//     centre is measured in the hole's plane), and the size's definition as
+//     SizeCharacteristicDefinitionId.
 //   - Value of a surface profile is the zone width 2 * max(|min|, |max|):
 //     the width of the narrowest zone centred on the nominal surface that
 //     holds every scanned point, the same quantity as ToleranceValue (QIF's
 //     Value is the actual value of the toleranced quantity). The signed
 //     extremes go to WorstPositiveDeviation / WorstNegativeDeviation. A
 //     point profile's Value is the report's value_mm (mean signed deviation).
-//     A characteristic without points has no Value.
+//     A size's Value is the measured size, its nominal's TargetValue the
+//     measured size minus its deviation; a position's Value is the true
+//     position (2 x the centre's distance from nominal). A characteristic
+//     without points, or a hole not measured, has no Value (nor TargetValue).
 //   - Status PASS/FAIL per characteristic is the report's verdict (which may
 //     allow a fraction of points outside the band, so a passing surface can
-//     have Value > ToleranceValue); InspectionStatus is the part's verdict.
+//     have Value > ToleranceValue); a hole's diameter, length and position
+//     each get their own (HoleVerdictsOf, core/report/report_content.h);
+//     not measured is INDETERMINATE. InspectionStatus is the part's verdict.
 //   - The scanned points stay in the PLY file: MeasurementResults'
 //     ExternalFileReference names it (URI relative to the QIF file).
 #pragma once

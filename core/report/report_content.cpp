@@ -42,23 +42,51 @@ void AddStatistics(const InspectionReport& r, ReportContent& c) {
                   {"p99", FormatMm(st.p99_mm)}};
 }
 
+// The labels of a hole's quantities, for every renderer.
+constexpr char kDiameter[] = "\u00d8", kWidth[] = "W", kLength[] = "L", kPosition[] = "TP";
+
+std::string Band(const ToleranceBand& b) {
+  return absl::StrCat(FormatMm(b.lower_mm), " / ", FormatMm(b.upper_mm));
+}
+
+// "Ø 8.012 (+0.012)"; "-" when not measured.
+std::string Size(const char* label, double measured_mm, double deviation_mm) {
+  if (!std::isfinite(measured_mm)) return "-";
+  return absl::StrFormat("%s %.3f (%s)", label, measured_mm, FormatMm(deviation_mm));
+}
+
+std::vector<std::string> HoleRow(const ReportCharacteristic& c) {
+  const bool slot = c.type == "slot";
+  const char* size = slot ? kWidth : kDiameter;
+  const std::string zone = absl::StrFormat("%s %.3f", kPosition, c.position_tolerance_mm);
+  std::string band = absl::StrCat(size, " ", Band(c.tolerance), "\n");
+  std::string value = "-";
+  if (c.measured()) {
+    value = absl::StrCat(Size(size, c.measured_diameter_mm, c.diameter_deviation_mm), "\n");
+    if (slot)
+      absl::StrAppend(&value, Size(kLength, c.measured_length_mm, c.length_deviation_mm), "\n");
+    absl::StrAppend(&value, absl::StrFormat("%s %.3f / %.3f", kPosition, c.true_position_mm,
+                                            c.position_tolerance_mm));
+  }
+  if (slot) absl::StrAppend(&band, kLength, " ", Band(c.length_tolerance), "\n");
+  const std::string arc = std::isfinite(c.arc_coverage_deg)
+                              ? absl::StrFormat("arc %.0f\u00b0", c.arc_coverage_deg)
+                              : "-";
+  return {c.name, c.type, c.verdict, band + zone,     value,
+          "-",    "-",    arc,       Count(c.points), CoverageText(c)};
+}
+
 // Failed rows first, each group in the report's order.
 void AddCharacteristics(const std::vector<ReportCharacteristic>& list, ReportContent& c) {
   ReportTable& t = c.characteristics;
-  t.header = {"characteristic", "type",   "verdict", "tolerance mm", "value / mean mm",
-              "min mm",         "max mm", "in tol",  "points",       "coverage"};
+  t.header = CharacteristicHeader();
   std::vector<std::size_t> order(list.size());
   std::iota(order.begin(), order.end(), 0);
   std::stable_partition(order.begin(), order.end(),
                         [&](std::size_t i) { return !list[i].passed(); });
   for (std::size_t i : order) {
-    const ReportCharacteristic& ch = list[i];
-    t.rows.push_back(
-        {ch.name, ch.type, ch.verdict,
-         absl::StrCat(FormatMm(ch.tolerance.lower_mm), " / ", FormatMm(ch.tolerance.upper_mm)),
-         FormatMm(ch.is_point() ? ch.value_mm : ch.mean_mm), FormatMm(ch.min_mm),
-         FormatMm(ch.max_mm), Percent(ch.fraction_within), Count(ch.points), CoverageText(ch)});
-    t.failed.push_back(!ch.passed());
+    t.rows.push_back(CharacteristicRow(list[i]));
+    t.failed.push_back(!list[i].passed());
   }
 }
 
@@ -81,6 +109,40 @@ void AddDefects(const std::vector<ReportDefect>& list, ReportContent& c) {
 }
 
 }  // namespace
+
+const std::vector<std::string>& CharacteristicHeader() {
+  static const std::vector<std::string> kHeader = {
+      "characteristic", "type",   "verdict",      "tolerance mm", "value / mean mm",
+      "min mm",         "max mm", "in tol / arc", "points",       "coverage"};
+  return kHeader;
+}
+
+std::vector<std::string> CharacteristicRow(const ReportCharacteristic& c) {
+  if (c.is_hole()) return HoleRow(c);
+  return {c.name,
+          c.type,
+          c.verdict,
+          Band(c.tolerance),
+          FormatMm(c.is_point() ? c.value_mm : c.mean_mm),
+          FormatMm(c.min_mm),
+          FormatMm(c.max_mm),
+          Percent(c.fraction_within),
+          Count(c.points),
+          CoverageText(c)};
+}
+
+HoleVerdicts HoleVerdictsOf(const ReportCharacteristic& c) {
+  if (!c.measured())
+    return {"not_measured", c.type == "slot" ? "not_measured" : "", "not_measured"};
+  auto within = [](const ToleranceBand& band, double deviation_mm) {
+    return band.Contains(static_cast<float>(deviation_mm)) ? "pass" : "fail";
+  };
+  HoleVerdicts v;
+  v.size = within(c.tolerance, c.diameter_deviation_mm);
+  if (c.type == "slot") v.length = within(c.length_tolerance, c.length_deviation_mm);
+  v.position = c.true_position_mm <= c.position_tolerance_mm ? "pass" : "fail";
+  return v;
+}
 
 std::string CoverageText(const ReportCharacteristic& c) {
   if (std::isnan(c.coverage)) return "-";

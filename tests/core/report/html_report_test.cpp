@@ -174,6 +174,27 @@ TEST(HtmlReport, PanelsFailedFirstDefectsCalibrationHistogram) {
   EXPECT_EQ(html.find("https://"), std::string::npos);  // no network
 }
 
+// A hole's row shows its size, true position and arc seen, one per line,
+// the same text as the PDF's table (core/report/report_content.h).
+TEST(HtmlReport, AHoleRowShowsSizeTruePositionAndArc) {
+  json r = Report();
+  r["characteristics"].push_back(json::parse(R"({
+      "name": "H1", "type": "hole", "verdict": "fail", "reason": "fail: true position",
+      "tolerance_mm": {"lower": -0.1, "upper": 0.1}, "points": 180,
+      "true_position_mm": 0.31, "position_tolerance_mm": 0.3, "measured_diameter_mm": 8.012,
+      "diameter_deviation_mm": 0.012, "arc_coverage_deg": 351})"));
+  const Points p = SomePoints(100);
+  auto page = Page(r, p);
+  ASSERT_TRUE(page.ok()) << page.status();
+  const std::string& html = page->html;
+  EXPECT_NE(html.find("<td>H1</td><td>hole</td><td class=\"fail\">fail</td>"
+                      "<td>\u00d8 -0.100 / +0.100<br>TP 0.300</td>"
+                      "<td>\u00d8 8.012 (+0.012)<br>TP 0.310 / 0.300</td><td>-</td><td>-</td>"
+                      "<td>arc 351\u00b0</td><td>180</td>"),
+            std::string::npos)
+      << html.substr(html.find("<table id=\"characteristics\""), 1500);
+}
+
 TEST(HtmlHistogram, LogAxisKeepsSmallBinsVisible) {
   const std::string svg = HistogramSvg(Typed(Report()).histogram, MakeDeviationPalette(0.3, 1.0));
   // The bin with 1 count is log10(2) / log10(1e6 + 1) ~ 5% of the tallest, not 1e-6.

@@ -210,6 +210,37 @@ TEST(PdfReport, BadInputsAreErrorsNotCrashes) {
   EXPECT_FALSE(WritePdfReport(dir.File("no/such/dir/r.pdf"), in).ok());
 }
 
+// A hole's row: its diameter with the deviation, its true position against
+// the zone and the arc seen, in the characteristics table.
+TEST(PdfReport, AHoleRowShowsSizeTruePositionAndArc) {
+  if (!HavePoppler()) GTEST_SKIP() << "poppler-utils not installed: PDF NOT CHECKED";
+  const Cloud c = MakeCloud(true);
+  InspectionReport report = Report("r");
+  ReportCharacteristic h;
+  h.name = "H1";
+  h.type = "hole";
+  h.verdict = "fail";
+  h.tolerance = {-0.1, 0.1};
+  h.position_tolerance_mm = 0.3;
+  h.points = 180;
+  h.true_position_mm = 0.31;
+  h.measured_diameter_mm = 8.012;
+  h.diameter_deviation_mm = 0.012;
+  h.arc_coverage_deg = 351;
+  report.characteristics.push_back(h);
+  PdfReportInput in;
+  in.part_id = "p";
+  in.report = &report;
+  in.points_in_part = &c.points;
+  in.deviation_mm = &c.deviation;
+  TempDir dir;
+  ASSERT_TRUE(WritePdfReport(dir.File("r.pdf"), in).ok());
+  const std::string text = NoSpace(Shell("pdftotext -raw '" + dir.File("r.pdf") + "' -"));
+  for (const char* s :
+       {"\u00d88.012(+0.012)", "TP0.310/0.300", "arc351\u00b0", "\u00d8-0.100/+0.100", "TP0.300"})
+    EXPECT_NE(text.find(s), std::string::npos) << s << "\n" << text;
+}
+
 // Many rows continue on further pages, each with the table's header.
 TEST(PdfReport, LongTablesContinueOnMorePages) {
   if (!HavePoppler()) GTEST_SKIP() << "poppler-utils not installed: PDF NOT CHECKED";

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <pugixml.hpp>
 #include <string>
+#include <vector>
 
 #include "core/pipeline/inspection_report.h"
 #include "core/types/status_macros.h"
@@ -43,6 +44,33 @@ json Report() {
       Characteristic("ridge", "region", "fail", -0.05, 0.15, 200, -0.02, 0.31),
       Characteristic("P1", "point", "pass", -0.1, 0.1, 12, -0.03, 0.01),
       Characteristic("P2", "point", "fail", -0.1, 0.1, 0, 0, 0)};
+  return r;
+}
+
+// A failed hole (inside its diameter band, outside its position zone), a
+// passing slot and a hole not measured, after the report's surface.
+json HoleReport() {
+  json r = Report();
+  r["characteristics"] = {r["characteristics"][0], json::parse(R"({
+      "name": "H1", "type": "hole", "verdict": "fail", "reason": "fail: true position",
+      "tolerance_mm": {"lower": -0.1, "upper": 0.1}, "points": 180,
+      "measured_position_mm": [10.1, 20.0, 5.0], "position_deviation_mm": [0.155, 0, 0],
+      "true_position_mm": 0.31, "position_tolerance_mm": 0.3, "measured_diameter_mm": 8.012,
+      "diameter_deviation_mm": 0.012, "form_mm": 0.02, "arc_coverage_deg": 351,
+      "pixel_pitch_mm": 0.25})"),
+                          json::parse(R"({
+      "name": "S1", "type": "slot", "verdict": "pass", "reason": "pass",
+      "tolerance_mm": {"lower": -0.1, "upper": 0.1}, "points": 300,
+      "measured_position_mm": [40, 20, 5], "position_deviation_mm": [0.06, 0, 0],
+      "true_position_mm": 0.12, "position_tolerance_mm": 0.2, "measured_width_mm": 6.05,
+      "width_deviation_mm": 0.05, "measured_length_mm": 14.1, "length_deviation_mm": 0.1,
+      "length_tolerance_mm": {"lower": -0.2, "upper": 0.3}, "arc_coverage_deg": 360})"),
+                          json::parse(R"({
+      "name": "H9", "type": "hole", "verdict": "not_measured",
+      "reason": "not measured: edge seen over 120 deg", "points": 0,
+      "tolerance_mm": {"lower": -0.1, "upper": 0.1}, "position_tolerance_mm": 0.2,
+      "measured_position_mm": null, "true_position_mm": null, "measured_diameter_mm": null,
+      "arc_coverage_deg": 120})")};
   return r;
 }
 
@@ -120,6 +148,85 @@ TEST(QifResults, EveryCharacteristicReadsBackAsTheReportSays) {
   EXPECT_EQ(k, 4);
 }
 
+pugi::xml_node Measurement(const pugi::xml_document& doc, const std::string& name) {
+  for (pugi::xpath_node n : doc.select_nodes("//CharacteristicMeasurements/*")) {
+    const pugi::xml_node item = ById(doc, n.node().child_value("CharacteristicItemId"));
+    if (item.child_value("Name") == name) return n.node();
+  }
+  return {};
+}
+
+// The definition behind a measurement: measurement -> item -> nominal -> definition.
+pugi::xml_node DefinitionOf(const pugi::xml_document& doc, pugi::xml_node m) {
+  const pugi::xml_node item = ById(doc, m.child_value("CharacteristicItemId"));
+  const pugi::xml_node nominal = ById(doc, item.child_value("CharacteristicNominalId"));
+  return ById(doc, nominal.child_value("CharacteristicDefinitionId"));
+}
+
+std::string NominalTarget(const pugi::xml_document& doc, pugi::xml_node m) {
+  const pugi::xml_node item = ById(doc, m.child_value("CharacteristicItemId"));
+  return ById(doc, item.child_value("CharacteristicNominalId")).child_value("TargetValue");
+}
+
+TEST(QifResults, HolesAreDiameterAndPositionSlotsWidthLengthAndPosition) {
+  auto xml = XmlOf(HoleReport().dump(), Context());
+  ASSERT_TRUE(xml.ok()) << xml.status();
+  pugi::xml_document doc;
+  ASSERT_TRUE(doc.load_string(xml->c_str()));
+  const pugi::xml_node list = doc.select_node("//CharacteristicMeasurements").node();
+  ASSERT_EQ(list.attribute("n").as_int(), 1 + 2 + 3 + 2);
+  std::vector<std::string> kinds;
+  for (pugi::xml_node m : list.children()) kinds.push_back(m.name());
+  EXPECT_EQ(kinds,
+            (std::vector<std::string>{
+                "SurfaceProfileCharacteristicMeasurement", "DiameterCharacteristicMeasurement",
+                "PositionCharacteristicMeasurement", "WidthCharacteristicMeasurement",
+                "LengthCharacteristicMeasurement", "PositionCharacteristicMeasurement",
+                "DiameterCharacteristicMeasurement", "PositionCharacteristicMeasurement"}));
+  // H1: the diameter is inside its band, the true position outside its zone.
+  const pugi::xml_node d = Measurement(doc, "H1 diameter"), p = Measurement(doc, "H1 position");
+  ASSERT_TRUE(d && p);
+  EXPECT_STREQ(d.child("Status").child_value("CharacteristicStatusEnum"), "PASS");
+  EXPECT_STREQ(p.child("Status").child_value("CharacteristicStatusEnum"), "FAIL");
+  EXPECT_EQ(d.child("Value").text().as_double(), 8.012);
+  EXPECT_EQ(NominalTarget(doc, d), "8");
+  EXPECT_EQ(p.child("Value").text().as_double(), 0.31);
+  const pugi::xml_node ddef = DefinitionOf(doc, d), pdef = DefinitionOf(doc, p);
+  EXPECT_EQ(ddef.select_node("Tolerance/MaxValue").node().text().as_double(), 0.1);
+  EXPECT_EQ(ddef.select_node("Tolerance/MinValue").node().text().as_double(), -0.1);
+  EXPECT_STREQ(ddef.select_node("Tolerance/DefinedAsLimit").node().child_value(), "false");
+  EXPECT_EQ(pdef.child("ToleranceValue").text().as_double(), 0.3);
+  EXPECT_STREQ(pdef.child_value("SizeCharacteristicDefinitionId"), ddef.attribute("id").value());
+  EXPECT_FALSE(pdef.select_node("ZoneShape/DiametricalZone").node().empty());
+  // S1: width, length (its own band) and position, all passing.
+  const pugi::xml_node w = Measurement(doc, "S1 width"), l = Measurement(doc, "S1 length");
+  ASSERT_TRUE(w && l);
+  EXPECT_EQ(w.child("Value").text().as_double(), 6.05);
+  EXPECT_EQ(NominalTarget(doc, w), "6");
+  EXPECT_EQ(l.child("Value").text().as_double(), 14.1);
+  EXPECT_EQ(NominalTarget(doc, l), "14");
+  EXPECT_EQ(DefinitionOf(doc, l).select_node("Tolerance/MaxValue").node().text().as_double(), 0.3);
+  for (const char* name : {"S1 width", "S1 length", "S1 position"})
+    EXPECT_STREQ(Measurement(doc, name).child("Status").child_value("CharacteristicStatusEnum"),
+                 "PASS")
+        << name;
+  // H9: not measured, so INDETERMINATE without a value or a nominal size.
+  for (const char* name : {"H9 diameter", "H9 position"}) {
+    const pugi::xml_node m = Measurement(doc, name);
+    ASSERT_TRUE(m) << name;
+    EXPECT_STREQ(m.child("Status").child_value("CharacteristicStatusEnum"), "INDETERMINATE");
+    EXPECT_TRUE(m.child("Value").empty()) << name;
+    EXPECT_EQ(NominalTarget(doc, m), "") << name;
+  }
+}
+
+TEST(QifResults, AHoleWithoutItsZoneIsNamed) {
+  json r = HoleReport();
+  r["characteristics"][1].erase("position_tolerance_mm");
+  EXPECT_NE(XmlOf(r.dump(), Context()).status().message().find("characteristics[1]"),
+            std::string::npos);
+}
+
 TEST(QifResults, SameInputGivesTheSameBytesAndStableCharacteristicUuids) {
   auto a = XmlOf(Report().dump(), Context());
   auto b = XmlOf(Report().dump(), Context());
@@ -168,7 +275,7 @@ TEST(QifResults, ValidatesAgainstTheQif3Schema) {
   json only_surface = Report();
   only_surface["characteristics"] = {only_surface["characteristics"][0]};
   only_surface["verdict"] = "pass";
-  for (const json& report : {Report(), only_surface}) {
+  for (const json& report : {Report(), only_surface, HoleReport()}) {
     const std::string path = dir.path() + "/r.qif";
     ASSERT_TRUE(WriteQifResults(path, *ParseReport(report.dump()), Context()).ok());
     const std::string cmd =

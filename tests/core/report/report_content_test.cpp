@@ -141,6 +141,74 @@ TEST(ReportContent, MissingFieldsAreDataLossNamingThem) {
   EXPECT_FALSE(ReportContentFromJson(bad).ok()) << "no verdict at all";
 }
 
+ReportCharacteristic Hole(const std::string& name, const std::string& type) {
+  ReportCharacteristic c;
+  c.name = name;
+  c.type = type;
+  c.verdict = "pass";
+  c.tolerance = {-0.1, 0.1};
+  c.position_tolerance_mm = 0.3;
+  c.points = 180;
+  c.measured_position_mm = {10.1, 20, 5};
+  c.position_deviation_mm = {0.1, 0, 0};
+  c.true_position_mm = 0.2;
+  c.measured_diameter_mm = 8.012;
+  c.diameter_deviation_mm = 0.012;
+  c.arc_coverage_deg = 351.2;
+  if (type == "slot") {
+    c.length_tolerance = {-0.2, 0.3};
+    c.measured_length_mm = 14.1;
+    c.length_deviation_mm = 0.1;
+  }
+  return c;
+}
+
+TEST(ReportContent, HoleRowsShowSizeTruePositionAndArc) {
+  ReportCharacteristic h = Hole("H1", "hole");
+  h.verdict = "fail";
+  h.true_position_mm = 0.31;
+  const std::vector<std::string> row = CharacteristicRow(h);
+  ASSERT_EQ(row.size(), CharacteristicHeader().size());
+  EXPECT_EQ(row[3], "\u00d8 -0.100 / +0.100\nTP 0.300");
+  EXPECT_EQ(row[4], "\u00d8 8.012 (+0.012)\nTP 0.310 / 0.300");
+  EXPECT_EQ(row[5], "-") << "no surface statistics for a hole";
+  EXPECT_EQ(row[7], "arc 351\u00b0");
+  EXPECT_EQ(row[8], "180");
+  const std::vector<std::string> slot = CharacteristicRow(Hole("S1", "slot"));
+  EXPECT_EQ(slot[3], "W -0.100 / +0.100\nL -0.200 / +0.300\nTP 0.300");
+  EXPECT_EQ(slot[4], "W 8.012 (+0.012)\nL 14.100 (+0.100)\nTP 0.200 / 0.300");
+  ReportCharacteristic unseen = Hole("H9", "hole");
+  unseen.verdict = "not_measured";
+  unseen.measured_diameter_mm = unseen.true_position_mm = NAN;
+  unseen.arc_coverage_deg = 120;
+  const std::vector<std::string> u = CharacteristicRow(unseen);
+  EXPECT_EQ(u[4], "-");
+  EXPECT_EQ(u[7], "arc 120\u00b0") << "how much of its edge was seen says why";
+}
+
+// Each part of a hole is judged by the rule that made the hole's verdict.
+TEST(ReportContent, HoleVerdictsJudgeEachPart) {
+  ReportCharacteristic h = Hole("H1", "hole");
+  h.true_position_mm = 0.31;
+  HoleVerdicts v = HoleVerdictsOf(h);
+  EXPECT_EQ(v.size, "pass");
+  EXPECT_EQ(v.position, "fail");
+  EXPECT_EQ(v.length, "");
+  h.true_position_mm = 0.3;  // on the zone's boundary: inside
+  h.diameter_deviation_mm = -0.1001;
+  v = HoleVerdictsOf(h);
+  EXPECT_EQ(v.size, "fail");
+  EXPECT_EQ(v.position, "pass");
+  ReportCharacteristic s = Hole("S1", "slot");
+  s.length_deviation_mm = 0.31;
+  EXPECT_EQ(HoleVerdictsOf(s).length, "fail");
+  s.verdict = "not_measured";
+  v = HoleVerdictsOf(s);
+  EXPECT_EQ(v.size, "not_measured");
+  EXPECT_EQ(v.length, "not_measured");
+  EXPECT_EQ(v.position, "not_measured");
+}
+
 TEST(ReportContent, FormatMm) {
   EXPECT_EQ(FormatMm(0.1234), "+0.123");
   EXPECT_EQ(FormatMm(-2), "-2.000");
