@@ -67,7 +67,7 @@ void RunTrend(const TrendArgs& a) {
   std::printf("%-20s %5s %10s %10s %7s %7s %11s %s\n", "characteristic", "n", "mean_mm",
               "sigma_w_mm", "cpk", "ppk", "slope/part", "alarms");
   for (const CharacteristicTrend& c : trend.characteristics)
-    std::printf("%-20s %5zu %10.4f %10.4f %7.2f %7.2f %+11.5f %zu\n", c.name.c_str(),
+    std::printf("%-20s %5zu %10.4f %10.4f %7.2f %7.2f %+11.5f %zu\n", TrendLabel(c).c_str(),
                 c.values_mm.size(), c.spc ? c.spc->mean_mm : NAN,
                 c.spc ? c.spc->sigma_within_mm : NAN, c.spc ? c.spc->cpk : NAN,
                 c.spc ? c.spc->ppk : NAN, c.drift ? c.drift->slope_mm_per_part : NAN,

@@ -26,6 +26,16 @@ absl::Status FillFromReportJson(const std::string& text, const std::string& wher
     r.lower_mm = c.tolerance.lower_mm;
     r.upper_mm = c.tolerance.upper_mm;
     r.points = static_cast<int64_t>(c.points);
+    if (c.is_hole()) {
+      r.size_mm = c.measured_diameter_mm;
+      r.size_deviation_mm = c.diameter_deviation_mm;
+      r.true_position_mm = c.true_position_mm;
+      r.position_tolerance_mm = c.position_tolerance_mm;
+      r.length_mm = c.measured_length_mm;
+      r.length_deviation_mm = c.length_deviation_mm;
+      r.length_lower_mm = c.length_tolerance.lower_mm;
+      r.length_upper_mm = c.length_tolerance.upper_mm;
+    }
     record->characteristics.push_back(std::move(r));
   }
   record->defects_json = EncodeDefects(report->defects).dump();

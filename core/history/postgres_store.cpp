@@ -125,13 +125,11 @@ absl::StatusOr<bool> PostgresStore::Record(const PartRecord& p) {
     if (r.affected_rows() == 0) return false;  // recorded before; the transaction is dropped
     for (std::size_t i = 0; i < p.characteristics.size(); ++i) {
       const CharacteristicRecord& c = p.characteristics[i];
-      tx.exec_params(
-          "INSERT INTO characteristics VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, "
-          "$13, $14)",
-          p.cell, p.part_id, static_cast<int64_t>(i), c.name, c.type, DoubleText(c.value_mm),
-          DoubleText(c.mean_mm), DoubleText(c.min_mm), DoubleText(c.max_mm),
-          DoubleText(c.stddev_mm), DoubleText(c.lower_mm), DoubleText(c.upper_mm), c.verdict,
-          c.points);
+      std::vector<std::string> numbers;
+      for (const double* v : CharacteristicNumbers(c)) numbers.push_back(DoubleText(*v));
+      tx.exec_params(InsertCharacteristicSql('$'), p.cell, p.part_id, static_cast<int64_t>(i),
+                     c.name, c.type, c.verdict, c.points,
+                     pqxx::prepare::make_dynamic_params(numbers));
     }
     const std::string packed = PackTriangles(p.triangles);
     tx.exec_params("INSERT INTO triangle_summaries VALUES ($1, $2, $3, $4)", p.cell, p.part_id,
@@ -162,21 +160,17 @@ void PostgresStore::LoadRows(pqxx::transaction_base& tx, const PartSelection& se
   std::map<std::string, PartRecord*> by_key;
   for (PartRecord& p : parts) by_key[StoreKey(p.cell, p.part_id)] = &p;
   for (const auto& row : tx.exec_params(
-           "SELECT c.cell, c.part_id, c.name, c.type, c.value_mm, c.mean_mm, c.min_mm, c.max_mm, "
-           "c.stddev_mm, c.lower_mm, c.upper_mm, c.verdict, c.points FROM characteristics c "
-           "JOIN parts p ON p.cell = c.cell AND p.part_id = c.part_id" +
-               Filter(sel) + " ORDER BY c.cell, c.part_id, c.position",
+           SelectCharacteristicsSql() + Filter(sel) + " ORDER BY c.cell, c.part_id, c.position",
            sel.cell, sel.since_utc)) {
     auto it = by_key.find(StoreKey(row[0].c_str(), row[1].c_str()));
     if (it == by_key.end()) continue;
     CharacteristicRecord c;
     c.name = row[2].c_str();
     c.type = row[3].c_str();
-    double* values[] = {&c.value_mm,  &c.mean_mm,  &c.min_mm,  &c.max_mm,
-                        &c.stddev_mm, &c.lower_mm, &c.upper_mm};
-    for (int k = 0; k < 7; ++k) *values[k] = TextDouble(row[4 + k]);
-    c.verdict = row[11].c_str();
-    c.points = row[12].as<int64_t>();
+    c.verdict = row[4].c_str();
+    c.points = row[5].as<int64_t>();
+    int k = 6;
+    for (double* v : CharacteristicNumbers(c)) *v = TextDouble(row[k++]);
     it->second->characteristics.push_back(std::move(c));
   }
 }

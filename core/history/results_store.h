@@ -22,15 +22,26 @@
 
 namespace surfinspect {
 
-// One characteristic's result on one part, as report.json gives it.
+// One characteristic's result on one part, as report.json gives it. NaN is
+// NULL in the database.
 struct CharacteristicRecord {
   std::string name;
-  std::string type;       // "surface", "region" or "point"
-  double value_mm = NAN;  // the charted value: a point's value_mm, else mean_mm
+  std::string type;  // "surface", "region", "point", "section", "hole" or "slot"
+  // A point's value_mm, else mean_mm (NaN for holes and slots, whose
+  // quantities are the fields below; the trend charts each, trend.h).
+  double value_mm = NAN;
   double mean_mm = NAN, min_mm = NAN, max_mm = NAN, stddev_mm = NAN;
-  double lower_mm = NAN, upper_mm = NAN;  // its tolerance
-  std::string verdict;                    // "pass" / "fail"
-  int64_t points = 0;
+  double lower_mm = NAN, upper_mm = NAN;  // its tolerance (a hole's: of its diameter)
+  std::string verdict;                    // "pass", "fail" or "not_measured"
+  int64_t points = 0;                     // a hole's: its edge points
+  // Holes and slots, as measured (NaN otherwise, and when not measured):
+  // the diameter (a slot's width) and its deviation from nominal, the true
+  // position and its zone's diameter, a slot's length with its deviation
+  // and band.
+  double size_mm = NAN, size_deviation_mm = NAN;
+  double true_position_mm = NAN, position_tolerance_mm = NAN;
+  double length_mm = NAN, length_deviation_mm = NAN;
+  double length_lower_mm = NAN, length_upper_mm = NAN;
 };
 
 // The deviation field on one CAD triangle of one part: the points whose

@@ -35,7 +35,9 @@ absl::StatusOr<SpcResult> ComputeSpc(const std::vector<double>& x, double lower_
   }
   r.mr_bar_mm = mr_sum / (r.n - 1);
   r.sigma_within_mm = r.mr_bar_mm / kD2;
-  const double width = upper_mm - lower_mm;
+  // A one-sided tolerance (lower -infinity: a true position) has no Cp or
+  // Pp; its Cpk and Ppk are the upper side's alone (Montgomery 8.2, the one-sided Cpu).
+  const double width = std::isfinite(lower_mm) ? upper_mm - lower_mm : NAN;
   const double nearest = std::min(upper_mm - r.mean_mm, r.mean_mm - lower_mm);
   r.cp = Index(width, 6 * r.sigma_within_mm);
   r.cpk = Index(nearest, 3 * r.sigma_within_mm);

@@ -38,7 +38,9 @@ struct SpcResult {
   std::vector<double> moving_ranges_mm;  // n - 1 values, MR_i for i = 1..n-1
 };
 
-// Needs at least 2 finite values and lower_mm < upper_mm.
+// Needs at least 2 finite values and lower_mm < upper_mm; lower_mm may be
+// -infinity (a one-sided tolerance: Cp and Pp NaN, Cpk and Ppk of the upper
+// limit).
 absl::StatusOr<SpcResult> ComputeSpc(const std::vector<double>& values_mm, double lower_mm,
                                      double upper_mm);
 

@@ -138,11 +138,7 @@ absl::StatusOr<bool> SqliteStore::Contains(const std::string& cell, const std::s
 }
 
 absl::Status SqliteStore::InsertCharacteristics(const PartRecord& part) {
-  ASSIGN_OR_RETURN(
-      auto s,
-      Prepare(
-          "INSERT INTO characteristics VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, "
-          "?13, ?14)"));
+  ASSIGN_OR_RETURN(auto s, Prepare(InsertCharacteristicSql('?')));
   for (std::size_t i = 0; i < part.characteristics.size(); ++i) {
     const CharacteristicRecord& c = part.characteristics[i];
     sqlite3_stmt* st = s.get();
@@ -152,11 +148,10 @@ absl::Status SqliteStore::InsertCharacteristics(const PartRecord& part) {
     sqlite3_bind_int64(st, 3, static_cast<int64_t>(i));
     BindText(st, 4, c.name);
     BindText(st, 5, c.type);
-    const double values[] = {c.value_mm,  c.mean_mm,  c.min_mm,  c.max_mm,
-                             c.stddev_mm, c.lower_mm, c.upper_mm};
-    for (int k = 0; k < 7; ++k) BindDouble(st, 6 + k, values[k]);
-    BindText(st, 13, c.verdict);
-    sqlite3_bind_int64(st, 14, c.points);
+    BindText(st, 6, c.verdict);
+    sqlite3_bind_int64(st, 7, c.points);
+    int k = 8;
+    for (const double* v : CharacteristicNumbers(c)) BindDouble(st, k++, *v);
     if (sqlite3_step(st) != SQLITE_DONE) return Error("cannot write characteristic " + c.name);
   }
   return absl::OkStatus();
@@ -221,15 +216,16 @@ absl::Status SqliteStore::LoadCharacteristics(std::vector<PartRecord>& parts,
                                               const PartSelection& sel) {
   return ForEachPartRow(
       parts,
-      "SELECT c.cell, c.part_id, c.name, c.type, c.value_mm, c.mean_mm, c.min_mm, c.max_mm, "
-      "c.stddev_mm, c.lower_mm, c.upper_mm, c.verdict, c.points FROM characteristics c "
-      "JOIN parts p ON p.cell = c.cell AND p.part_id = c.part_id" +
-          PartFilter(sel, "c") + " ORDER BY c.cell, c.part_id, c.position",
+      SelectCharacteristicsSql() + PartFilter(sel, "c") + " ORDER BY c.cell, c.part_id, c.position",
       sel, "characteristics", [](sqlite3_stmt* r, PartRecord& part) -> absl::Status {
-        part.characteristics.push_back(  // the columns in CharacteristicRecord's order
-            {ColumnText(r, 2), ColumnText(r, 3), ColumnDouble(r, 4), ColumnDouble(r, 5),
-             ColumnDouble(r, 6), ColumnDouble(r, 7), ColumnDouble(r, 8), ColumnDouble(r, 9),
-             ColumnDouble(r, 10), ColumnText(r, 11), sqlite3_column_int64(r, 12)});
+        CharacteristicRecord c;
+        c.name = ColumnText(r, 2);
+        c.type = ColumnText(r, 3);
+        c.verdict = ColumnText(r, 4);
+        c.points = sqlite3_column_int64(r, 5);
+        int k = 6;
+        for (double* v : CharacteristicNumbers(c)) *v = ColumnDouble(r, k++);
+        part.characteristics.push_back(std::move(c));
         return absl::OkStatus();
       });
 }

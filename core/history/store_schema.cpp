@@ -8,6 +8,17 @@
 namespace surfinspect {
 namespace {
 
+// The characteristics columns of CharacteristicRecord's hole fields, in
+// its order (each ADD COLUMN its own statement: SQLite takes one a time).
+std::vector<std::string> HoleColumns() {
+  std::vector<std::string> out;
+  for (const char* column :
+       {"size_mm", "size_deviation_mm", "true_position_mm", "position_tolerance_mm", "length_mm",
+        "length_deviation_mm", "length_lower_mm", "length_upper_mm"})
+    out.push_back(absl::StrCat("ALTER TABLE characteristics ADD COLUMN ", column, " {double}"));
+  return out;
+}
+
 // Migration k is kMigrations[k - 1]. Never edit one that has shipped: add
 // the next.
 const std::vector<std::vector<std::string>>& Migrations() {
@@ -31,6 +42,9 @@ const std::vector<std::vector<std::string>>& Migrations() {
       // 2: the trend's selections by time and by characteristic.
       {"CREATE INDEX parts_by_time ON parts (inspected_utc, cell, part_id)",
        "CREATE INDEX characteristics_by_name ON characteristics (name)"},
+      // 3: holes' and slots' quantities (NULL for the other types, and for
+      // parts recorded before), at the end of the row in both databases.
+      HoleColumns(),
   };
   return kMigrations;
 }
@@ -63,6 +77,20 @@ std::vector<std::string> MigrationStatements(int version, const SqlDialect& dial
     out.push_back(
         absl::StrReplaceAll(s, {{"{blob}", dialect.blob}, {"{double}", dialect.double_}}));
   return out;
+}
+
+std::string InsertCharacteristicSql(char mark) {
+  std::string columns = "cell, part_id, position, name, type, verdict, points", values;
+  for (const char* c : kCharacteristicNumberColumns) absl::StrAppend(&columns, ", ", c);
+  for (std::size_t k = 1; k <= 7 + kCharacteristicNumberColumns.size(); ++k)
+    absl::StrAppend(&values, k == 1 ? "" : ", ", std::string(1, mark), k);
+  return absl::StrCat("INSERT INTO characteristics (", columns, ") VALUES (", values, ")");
+}
+
+std::string SelectCharacteristicsSql() {
+  std::string sql = "SELECT c.cell, c.part_id, c.name, c.type, c.verdict, c.points";
+  for (const char* c : kCharacteristicNumberColumns) absl::StrAppend(&sql, ", c.", c);
+  return sql + " FROM characteristics c JOIN parts p ON p.cell = c.cell AND p.part_id = c.part_id";
 }
 
 int LatestSchemaVersion() { return static_cast<int>(Migrations().size()); }

@@ -1,10 +1,13 @@
 #include "core/history/trend.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "absl/strings/str_replace.h"
 
 namespace surfinspect {
 namespace {
@@ -13,6 +16,28 @@ nlohmann::json Num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nul
 
 nlohmann::json LimitsJson(const ControlLimits& l) {
   return {{"center_mm", Num(l.center)}, {"lower_mm", Num(l.lower)}, {"upper_mm", Num(l.upper)}};
+}
+
+// One value a part's characteristic charts, with its tolerance.
+struct Charted {
+  const char* quantity;
+  double value_mm, lower_mm, upper_mm;
+};
+
+// A hole's sizes are charted as deviations from nominal (as every other
+// series is, against the band the plan gives, known even on parts where the
+// hole was not measured); its true position against its zone alone, since
+// a position has no lower limit.
+std::vector<Charted> ChartedValues(const CharacteristicRecord& c) {
+  if (c.type != "hole" && c.type != "slot")
+    return {{"deviation", c.value_mm, c.lower_mm, c.upper_mm}};
+  const bool slot = c.type == "slot";
+  std::vector<Charted> out = {
+      {slot ? "width" : "diameter", c.size_deviation_mm, c.lower_mm, c.upper_mm}};
+  if (slot) out.push_back({"length", c.length_deviation_mm, c.length_lower_mm, c.length_upper_mm});
+  out.push_back({"true_position", c.true_position_mm, -std::numeric_limits<double>::infinity(),
+                 c.position_tolerance_mm});
+  return out;
 }
 
 CharacteristicTrend Analyse(CharacteristicTrend c) {
@@ -34,6 +59,7 @@ nlohmann::json CharacteristicJson(const CharacteristicTrend& c) {
     violations.push_back({{"rule", v.rule}, {"part_id", c.part_ids[v.index]}});
   return {{"name", c.name},
           {"type", c.type},
+          {"quantity", c.quantity},
           {"n", c.values_mm.size()},
           {"tolerance_mm", {{"lower", Num(c.lower_mm)}, {"upper", Num(c.upper_mm)}}},
           {"mean_mm", s ? Num(c.spc->mean_mm) : nullptr},
@@ -55,36 +81,47 @@ nlohmann::json CharacteristicJson(const CharacteristicTrend& c) {
 
 }  // namespace
 
+std::string QuantityText(const std::string& quantity) {
+  return absl::StrReplaceAll(quantity, {{"_", " "}});
+}
+
+std::string TrendLabel(const CharacteristicTrend& c) {
+  return c.quantity == "deviation" ? c.name : absl::StrCat(c.name, " ", QuantityText(c.quantity));
+}
+
 absl::StatusOr<Trend> ComputeTrend(const std::vector<PartRecord>& parts,
                                    const std::string& characteristic) {
   if (parts.empty()) return absl::NotFoundError("no parts selected");
   Trend trend;
   std::vector<CharacteristicTrend> series;
-  std::map<std::string, std::size_t> index;
+  std::map<std::pair<std::string, std::string>, std::size_t> index;  // (name, quantity)
+  std::vector<std::string> names;                                    // in first-seen order
   for (const PartRecord& p : parts) {
     trend.part_ids.push_back(p.part_id);
     for (const CharacteristicRecord& c : p.characteristics) {
-      auto [it, fresh] = index.emplace(c.name, series.size());
-      if (fresh) {
-        series.emplace_back();
-        series.back().name = c.name;
-        series.back().type = c.type;
+      if (std::find(names.begin(), names.end(), c.name) == names.end()) names.push_back(c.name);
+      for (const Charted& v : ChartedValues(c)) {
+        auto [it, fresh] = index.emplace(std::make_pair(c.name, v.quantity), series.size());
+        if (fresh) {
+          series.emplace_back();
+          series.back().name = c.name;
+          series.back().type = c.type;
+          series.back().quantity = v.quantity;
+        }
+        CharacteristicTrend& s = series[it->second];
+        s.lower_mm = v.lower_mm;
+        s.upper_mm = v.upper_mm;
+        if (!std::isfinite(v.value_mm)) continue;
+        s.part_ids.push_back(p.part_id);
+        s.values_mm.push_back(v.value_mm);
       }
-      CharacteristicTrend& s = series[it->second];
-      s.lower_mm = c.lower_mm;
-      s.upper_mm = c.upper_mm;
-      if (!std::isfinite(c.value_mm)) continue;
-      s.part_ids.push_back(p.part_id);
-      s.values_mm.push_back(c.value_mm);
     }
   }
-  if (!characteristic.empty() && !index.count(characteristic)) {
-    std::vector<std::string> names;
-    for (const auto& s : series) names.push_back(s.name);
+  if (!characteristic.empty() &&
+      std::find(names.begin(), names.end(), characteristic) == names.end())
     return absl::NotFoundError(absl::StrCat(
         "unknown characteristic '", characteristic,
         "'; the selected parts have: ", names.empty() ? "none" : absl::StrJoin(names, ", ")));
-  }
   for (CharacteristicTrend& s : series)
     if (characteristic.empty() || s.name == characteristic)
       trend.characteristics.push_back(Analyse(std::move(s)));

@@ -59,8 +59,12 @@ std::string Chart(const std::string& label, const std::vector<double>& y,
 }
 
 std::string Section(const CharacteristicTrend& c) {
-  std::string html = absl::StrCat("<h2>", HtmlEscape(c.name), " <small>(", HtmlEscape(c.type), ", ",
-                                  c.values_mm.size(), " parts)</small></h2>\n");
+  // The name alone first in the heading (the page's tests read it); a
+  // hole's quantity beside the type.
+  const std::string quantity =
+      c.quantity == "deviation" ? "" : absl::StrCat(", ", QuantityText(c.quantity));
+  std::string html = absl::StrCat("<h2>", HtmlEscape(c.name), " <small>(", HtmlEscape(c.type),
+                                  quantity, ", ", c.values_mm.size(), " parts)</small></h2>\n");
   if (!c.spc) return html + "<p>Fewer than 2 values: no SPC.</p>\n";
   const SpcResult& s = *c.spc;
   absl::StrAppend(

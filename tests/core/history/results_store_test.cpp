@@ -29,7 +29,8 @@ namespace {
 using testing::PostgresServer;
 using testing::TempDir;
 
-constexpr int kCharacteristics = 3;
+constexpr int kProfiles = 3;                     // surface, region, point
+constexpr int kCharacteristics = kProfiles + 1;  // and a hole
 
 PartRecord MakePart(const std::string& cell, int k, uint32_t triangles = 50) {
   std::mt19937_64 rng(k * 7919 + std::hash<std::string>()(cell));
@@ -44,8 +45,8 @@ PartRecord MakePart(const std::string& cell, int k, uint32_t triangles = 50) {
   p.defects_json = R"([{"id":1,"kind":"dent"}])";
   p.calibration_json = R"({"viewpoints":[]})";
   p.files_json = R"({"report":"r.json"})";
-  const char* names[kCharacteristics] = {"surface", "ridge", "ridge-centre"};
-  for (int c = 0; c < kCharacteristics; ++c) {
+  const char* names[kProfiles] = {"surface", "ridge", "ridge-centre"};
+  for (int c = 0; c < kProfiles; ++c) {
     CharacteristicRecord r;
     r.name = names[c];
     r.type = c == 2 ? "point" : c == 1 ? "region" : "surface";
@@ -60,6 +61,19 @@ PartRecord MakePart(const std::string& cell, int k, uint32_t triangles = 50) {
     r.points = 1000 + k;
     p.characteristics.push_back(r);
   }
+  // A hole, not measured on part 3 (its measured fields NULL).
+  CharacteristicRecord h;
+  h.name = "H1";
+  h.type = "hole";
+  h.lower_mm = -0.1, h.upper_mm = 0.1, h.position_tolerance_mm = 0.3;
+  h.verdict = k == 3 ? "not_measured" : "pass";
+  if (k != 3) {
+    h.size_deviation_mm = noise(rng);
+    h.size_mm = 8 + h.size_deviation_mm;
+    h.true_position_mm = std::abs(noise(rng)) + 0.002 * k;
+    h.points = 200;
+  }
+  p.characteristics.push_back(h);
   p.num_triangles = triangles;
   for (uint32_t t = 0; t < triangles; t += 1 + (k % 3))
     p.triangles.push_back({t, 3, static_cast<float>(noise(rng)), -1.f, 1.f});
@@ -79,10 +93,15 @@ void ExpectSame(const PartRecord& a, const PartRecord& b) {
   EXPECT_EQ(a.calibration_json, b.calibration_json);
   ASSERT_EQ(a.characteristics.size(), b.characteristics.size());
   for (std::size_t i = 0; i < a.characteristics.size(); ++i) {
-    EXPECT_EQ(a.characteristics[i].name, b.characteristics[i].name);
-    EXPECT_EQ(a.characteristics[i].value_mm, b.characteristics[i].value_mm);  // bit-exact
-    EXPECT_EQ(std::isnan(a.characteristics[i].max_mm), std::isnan(b.characteristics[i].max_mm));
-    EXPECT_EQ(a.characteristics[i].points, b.characteristics[i].points);
+    const CharacteristicRecord &x = a.characteristics[i], &y = b.characteristics[i];
+    EXPECT_EQ(x.name, y.name);
+    EXPECT_EQ(x.type, y.type);
+    EXPECT_EQ(x.verdict, y.verdict);
+    EXPECT_EQ(x.points, y.points);
+    const auto xs = CharacteristicNumbers(x), ys = CharacteristicNumbers(y);
+    for (std::size_t k = 0; k < xs.size(); ++k)  // bit-exact, and a NULL survives the trip
+      EXPECT_TRUE(*xs[k] == *ys[k] || (std::isnan(*xs[k]) && std::isnan(*ys[k])))
+          << x.name << " " << kCharacteristicNumberColumns[k] << ": " << *xs[k] << " vs " << *ys[k];
   }
   ASSERT_EQ(a.triangles.size(), b.triangles.size());
   for (std::size_t i = 0; i < a.triangles.size(); ++i) {

@@ -61,6 +61,18 @@ TEST(Spc, RandomSeriesEqualTheTextbookFormulas) {
   }
 }
 
+// A true position has an upper limit alone: no Cp or Pp, and Cpk, Ppk of
+// the upper side (the hand-worked series above against USL 17).
+TEST(Spc, OneSidedToleranceHasTheUpperSideOnly) {
+  auto r = ComputeSpc({10, 12, 11, 13, 12}, -INFINITY, 17);
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_TRUE(std::isnan(r->cp));
+  EXPECT_TRUE(std::isnan(r->pp));
+  EXPECT_NEAR(r->cpk, 5.4 / (3 * 1.329787), 1e-5);
+  EXPECT_NEAR(r->ppk, 5.4 / (3 * 1.140175), 1e-5);
+  EXPECT_NEAR(r->individuals.upper, 11.6 + 3 * 1.329787, 1e-5);
+}
+
 TEST(Spc, ConstantSeriesHasUndefinedIndices) {
   auto r = ComputeSpc({0.02, 0.02, 0.02}, -0.1, 0.1);
   ASSERT_TRUE(r.ok());

@@ -69,6 +69,61 @@ TEST(Trend, JsonHasTheDocumentedKeys) {
   EXPECT_EQ(j["trend_map"]["largest"]["triangle_id"], 5);
 }
 
+// Parts with a hole H1 (diameter deviation 0.01 k mm, true position 0.02 k
+// mm) and a slot S1, the hole not measured on the third part.
+std::vector<PartRecord> HoleParts(int n) {
+  std::vector<PartRecord> parts;
+  for (int k = 0; k < n; ++k) {
+    PartRecord p;
+    p.part_id = "p" + std::to_string(k);
+    CharacteristicRecord h, s;
+    h.name = "H1", h.type = "hole", h.lower_mm = -0.1, h.upper_mm = 0.1;
+    h.position_tolerance_mm = 0.3;
+    if (k != 2) {
+      h.size_mm = 8 + 0.01 * k, h.size_deviation_mm = 0.01 * k;
+      h.true_position_mm = 0.02 * k;
+    }
+    s.name = "S1", s.type = "slot", s.lower_mm = -0.1, s.upper_mm = 0.1;
+    s.position_tolerance_mm = 0.2, s.length_lower_mm = -0.2, s.length_upper_mm = 0.3;
+    s.size_deviation_mm = 0.001 * (k % 3), s.length_deviation_mm = 0.05 + 0.002 * (k % 2);
+    s.true_position_mm = 0.05 + 0.001 * k;
+    p.characteristics = {h, s};
+    parts.push_back(p);
+  }
+  return parts;
+}
+
+TEST(Trend, HolesChartTheirSizesAndTruePosition) {
+  auto trend = ComputeTrend(HoleParts(6));
+  ASSERT_TRUE(trend.ok()) << trend.status();
+  std::vector<std::string> labels;
+  for (const CharacteristicTrend& c : trend->characteristics) labels.push_back(TrendLabel(c));
+  EXPECT_EQ(labels, (std::vector<std::string>{"H1 diameter", "H1 true position", "S1 width",
+                                              "S1 length", "S1 true position"}));
+  const CharacteristicTrend& d = trend->characteristics[0];
+  EXPECT_EQ(d.quantity, "diameter");
+  EXPECT_EQ(d.values_mm, (std::vector<double>{0, 0.01, 0.03, 0.04, 0.05}));  // not p2
+  EXPECT_EQ(d.part_ids[2], "p3");
+  EXPECT_EQ(d.upper_mm, 0.1);
+  const CharacteristicTrend& tp = trend->characteristics[1];
+  ASSERT_TRUE(tp.spc);
+  EXPECT_EQ(tp.lower_mm, -INFINITY);  // one-sided: Cp undefined, Cpk of the zone
+  EXPECT_TRUE(std::isnan(tp.spc->cp));
+  EXPECT_NEAR(tp.spc->cpk, (0.3 - tp.spc->mean_mm) / (3 * tp.spc->sigma_within_mm), 1e-12);
+  EXPECT_EQ(trend->characteristics[3].lower_mm, -0.2);  // the length's own band
+  // A name takes all of its quantities; trend.json says which each is.
+  auto s1 = ComputeTrend(HoleParts(6), "S1");
+  ASSERT_TRUE(s1.ok());
+  ASSERT_EQ(s1->characteristics.size(), 3u);
+  const nlohmann::json j = TrendJson(*s1, {});
+  EXPECT_EQ(j["characteristics"][1]["quantity"], "length");
+  EXPECT_EQ(j["characteristics"][2]["quantity"], "true_position");
+  EXPECT_TRUE(j["characteristics"][2]["tolerance_mm"]["lower"].is_null());
+  const std::string html = TrendHtml(*s1, "t", "");
+  EXPECT_NE(html.find("<h2>S1 <small>(slot, true position, 6 parts)</small></h2>"),
+            std::string::npos);
+}
+
 TEST(Trend, RefusesEmptySelectionAndUnknownCharacteristic) {
   EXPECT_EQ(ComputeTrend({}).status().code(), absl::StatusCode::kNotFound);
   const auto st = ComputeTrend(Parts(3, 0), "ridge-left").status();
