@@ -3,7 +3,8 @@
 #  1. write the demo cell (CAD, gauge, viewpoints, simulated gauge scans)
 #  2. start surfinspectd on a free loopback port
 #  3. cell-agent calibrate (ICP per viewpoint on the service)
-#  4. cell-agent run --simulate 3 --once (robot drops 3 parts with dents)
+#  4. cell-agent run --simulate 3 --hole-shift 0.4 --once (robot drops 3 parts
+#     with dents; the third is made with its first hole 0.4 mm off)
 #  5. print per part the verdict, the failed characteristics, the defects
 #     found and the planted ones (archive/PART/truth.json)
 #  6. stop the server (nothing is left running, even on failure)
@@ -38,10 +39,10 @@ TARGET=$(sed -n 's/^surfinspectd listening on //p' "$OUT/server.out")
 say "3. Calibrate the five viewpoints against the gauge"
 "$BIN/cell-agent" calibrate --cell "$OUT/cell/cell.json" --server "$TARGET"
 
-say "4. Inspect three simulated parts with planted dents and bumps"
+say "4. Inspect three simulated parts with planted dents and bumps (the third: a hole 0.4 mm off)"
 cd "$OUT"
 "$BIN/cell-agent" run --cell cell/cell.json --server "$TARGET" --inbox inbox --results results \
-  --archive archive --quarantine quarantine --simulate 3 --once
+  --archive archive --quarantine quarantine --simulate 3 --hole-shift 0.4 --once
 
 say "5. Results: failed characteristics, defects found and planted"
 for d in results/*/; do
@@ -60,9 +61,14 @@ for f in r["defects"]:
         f["id"], f["kind"], f["peak_mm"], x, y, z, f["area_mm2"],
         ", " + f["region"] if f["region"] else ""))
 try:
-    planted = json.load(open(truth_path))["defects"]
-except (OSError, ValueError, KeyError):
-    planted = []
+    truth = json.load(open(truth_path))
+except (OSError, ValueError):
+    truth = {}
+planted = truth.get("defects", [])
+for h in truth.get("holes", []):
+    x, y, z = h["cad_position_mm"]
+    print("     planted hole at (%7.1f, %5.1f, %5.1f) moved %.2f mm: true position %.2f mm" % (
+        x, y, z, sum(v * v for v in h["shift_mm"]) ** 0.5, h["true_position_mm"]))
 for p in planted:
     x, y, z = p["center_in_part"]
     print("     planted %-8s %+.3f mm at (%7.1f, %5.1f, %5.1f), r=%.1f mm" % (

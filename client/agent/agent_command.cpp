@@ -235,8 +235,8 @@ absl::Status SimulateIfAsked(const AgentArgs& a, const CellConfig& cell, const I
   if (!a.drift.empty()) {
     ASSIGN_OR_RETURN(surface, ParseSurfaceDrift(a.drift));
   }
-  ASSIGN_OR_RETURN(const auto ids,
-                   SimulateParts(cell, layout.inbox, a.simulate, a.seed, surface, drift));
+  ASSIGN_OR_RETURN(const auto ids, SimulateParts(cell, layout.inbox, a.simulate, a.seed, surface,
+                                                 drift, a.hole_shift_mm));
   Tell(out.info,
        absl::StrCat("simulated robot: ", ids.size(), " parts dropped into ", layout.inbox));
   return absl::OkStatus();

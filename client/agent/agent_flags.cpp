@@ -42,6 +42,10 @@ void AddRunOptions(CLI::App* run, AgentArgs& a) {
   run->add_option("--drift", a.drift,
                   "with --simulate: a process drift, bow:RATE_MM[:X,Y,R] (grows per part) or "
                   "shift:AMOUNT_MM@PART[:X,Y,R]; its truth goes into truth.json");
+  run->add_option("--hole-shift", a.hole_shift_mm,
+                  "with --simulate: every third part is made with the CAD's first hole moved MM "
+                  "along x in its plane (truth.json \"holes\")")
+      ->check(CLI::Range(0.0, 2.0));
   run->add_option("--db", a.db,
                   "results store: SQLite file or postgresql://user@host/db (password from "
                   "PGPASSWORD/PGPASSFILE); default RESULTS/results.db; none = off")

@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <random>
 
 #include "absl/strings/numbers.h"
@@ -15,6 +16,8 @@
 #include "core/io/io_mesh.h"
 #include "core/io/io_point_cloud.h"
 #include "core/io/io_transform.h"
+#include "core/plan/cad_holes.h"
+#include "core/simulation/hole_changes.h"
 #include "core/simulation/scan_simulator.h"
 #include "core/types/status_macros.h"
 
@@ -176,6 +179,25 @@ absl::Status DropPart(const CellConfig& cell, const TriangleMesh& part, const fs
   return WriteStringAtomically((dir / "DONE").string(), "");
 }
 
+// The part made with the CAD's first hole moved `mm` along +x in its plane.
+struct MadePart {
+  TriangleMesh mesh;
+  nlohmann::json truth;
+};
+absl::StatusOr<MadePart> ShiftFirstHole(const TriangleMesh& cad, double mm) {
+  const std::vector<CadHole> holes = ListHoles(cad);
+  if (holes.empty()) return absl::InvalidArgumentError("--hole-shift: the part has no hole");
+  const Eigen::Vector3d& a = holes[0].axis;
+  const Eigen::Vector3d shift = mm * (Eigen::Vector3d::UnitX() - a.x() * a).normalized();
+  MadePart made;
+  ASSIGN_OR_RETURN(made.mesh, ChangeHoles(cad, {{0, shift, 0}}));
+  const Eigen::Vector3d& c = holes[0].position_mm;
+  made.truth = nlohmann::json::array({{{"cad_position_mm", {c.x(), c.y(), c.z()}},
+                                       {"shift_mm", {shift.x(), shift.y(), shift.z()}},
+                                       {"true_position_mm", 2 * mm}}});
+  return made;
+}
+
 // "X,Y,R" after a spec's second colon.
 absl::Status ParsePlace(const std::string& spec, const std::string& text, SurfaceDrift* d) {
   std::vector<std::string> xyr = absl::StrSplit(text, ',');
@@ -255,8 +277,13 @@ absl::StatusOr<SurfaceDrift> ParseSurfaceDrift(const std::string& spec) {
 absl::StatusOr<std::vector<std::string>> SimulateParts(const CellConfig& cell,
                                                        const std::string& inbox, int count,
                                                        uint64_t seed, const SurfaceDrift& drift,
-                                                       const RobotDrift& robot) {
+                                                       const RobotDrift& robot,
+                                                       double hole_shift_mm) {
   ASSIGN_OR_RETURN(auto part, ReadCellPartMesh(cell));
+  std::optional<MadePart> shifted;
+  if (hole_shift_mm > 0) {
+    ASSIGN_OR_RETURN(shifted, ShiftFirstHole(part, hole_shift_mm));
+  }
   std::mt19937_64 rng(seed);
   std::vector<std::string> ids;
   for (int k = 0, n = 1; k < count; ++n) {
@@ -270,7 +297,10 @@ absl::StatusOr<std::vector<std::string>> SimulateParts(const CellConfig& cell,
     nlohmann::json truth = {{"defects", PlantDefects(part, rng, &opt, clear)}};
     if (drift.kind != SurfaceDrift::Kind::kNone)
       truth["drift"] = PlantDrift(part, drift, k - 1, &opt);
-    RETURN_IF_ERROR(DropPart(cell, part, fs::path(inbox) / id, opt, truth, seed, n, robot));
+    const bool shift = shifted && k % 3 == 0;
+    if (shift) truth["holes"] = shifted->truth;
+    RETURN_IF_ERROR(DropPart(cell, shift ? shifted->mesh : part, fs::path(inbox) / id, opt, truth,
+                             seed, n, robot));
     ids.push_back(id);
   }
   return ids;

@@ -61,11 +61,12 @@ struct SurfaceDrift {
 absl::StatusOr<SurfaceDrift> ParseSurfaceDrift(const std::string& spec);
 
 // Returns the new part ids. `drift` changes the parts' surface, `robot`
-// the pose the sensor really scans from.
-absl::StatusOr<std::vector<std::string>> SimulateParts(const CellConfig& cell,
-                                                       const std::string& inbox, int count,
-                                                       uint64_t seed,
-                                                       const SurfaceDrift& drift = {},
-                                                       const RobotDrift& robot = {});
+// the pose the sensor really scans from. `hole_shift_mm` > 0: every third
+// part (the 3rd, 6th, ...) is made with the CAD's first hole (ListHoles
+// order) moved this far along +x in its plane (core/simulation/
+// hole_changes.h), its truth in truth.json's "holes".
+absl::StatusOr<std::vector<std::string>> SimulateParts(
+    const CellConfig& cell, const std::string& inbox, int count, uint64_t seed,
+    const SurfaceDrift& drift = {}, const RobotDrift& robot = {}, double hole_shift_mm = 0);
 
 }  // namespace surfinspect::client

@@ -11,6 +11,7 @@
 #include "core/io/io_mesh.h"
 #include "core/io/io_point_cloud.h"
 #include "core/io/io_transform.h"
+#include "core/plan/inspection_plan.h"
 #include "core/simulation/acceptance_artefacts.h"
 #include "core/types/status_macros.h"
 
@@ -99,9 +100,12 @@ double RidgeTopZ(const TriangleMesh& part, double x) {
 // comparison points along it; a section across it at x = 0 (a 1 mm slab,
 // the ridge's band); defect detection with the threshold chosen
 // for the scans' noise (sigma 0.015 mm: 0.03 mm is ~7 sigma of the local
-// median). The surface keeps the cell's tolerance_mm.
+// median); and every hole and slot the CAD has (ListHoles), H1.. and S1..
+// in its order, with a 0.3 mm true-position zone. The surface keeps the
+// cell's tolerance_mm.
 nlohmann::json PlanJson(const DemoCell& cell) {
   const Bounds3 b = ComputeBounds(cell.part);
+  nlohmann::json holes = PlanHolesJson(ListHoles(cell.part), 0.3);
   nlohmann::json points = nlohmann::json::array();
   for (const auto& [name, x] : {std::pair<const char*, double>{"ridge-left", -100.0},
                                 {"ridge-centre", 0.0},
@@ -127,6 +131,8 @@ nlohmann::json PlanJson(const DemoCell& cell) {
          {"region", "ridge"},
          {"tolerance_mm", {{"lower", -0.15}, {"upper", 0.15}}},
          {"allowed_fraction_outside", 0.001}}}},
+      {"holes", holes["holes"]},
+      {"slots", holes["slots"]},
       {"defects", {{"threshold_mm", 0.03}, {"min_area_mm2", 3.0}}}};
 }
 

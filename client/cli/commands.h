@@ -36,5 +36,6 @@ void AddErrorMapCommand(CLI::App& app);
 void AddAcceptanceCommand(CLI::App& app);
 void AddTrendCommand(CLI::App& app);
 void AddCadCommand(CLI::App& app);
+void AddHolesCommand(CLI::App& app);
 
 }  // namespace surfinspect::cli

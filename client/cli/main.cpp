@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   surfinspect::cli::AddAcceptanceCommand(app);
   surfinspect::cli::AddTrendCommand(app);
   surfinspect::cli::AddCadCommand(app);
+  surfinspect::cli::AddHolesCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -50,28 +50,13 @@ struct ReportWhiskers {
 
 struct ReportSection {
   std::string name;
-  // The plane: a point on it and its unit normal (zero when the cut holds
-  // nothing to find it from). See PlaneOfCut.
+  // The plan's plane: its point and unit normal.
   Eigen::Vector3d point_mm = Eigen::Vector3d::Zero();
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
   ToleranceBand tolerance{NAN, NAN};  // the section's band; NaN when not said
   std::vector<ReportPolyline> polylines;
   ReportWhiskers whiskers;
 };
-
-// The plane of a cut, found from the cut alone (PlanOutcome keeps the cut,
-// not the plan's entry): the point is the centroid of the curve's vertices
-// (of the whiskers' feet when the curve is empty); the normal is the
-// direction orthogonal to every in-plane vector the cut holds (the curve's
-// chords and the whiskers' directions: the least eigenvector of their
-// scatter), signed so that its largest component is positive. A straight
-// curve with no whisker fixes only a line; any plane through it is taken.
-// Zero point and normal for an empty cut.
-struct CutPlane {
-  Eigen::Vector3d point_mm = Eigen::Vector3d::Zero();
-  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-};
-CutPlane PlaneOfCut(const SectionCut& cut);
 
 // One ReportSection per cut of `outcome`, in plan order: cut k is the k-th
 // characteristic of type section (name and band), rounded as above.

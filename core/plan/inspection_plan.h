@@ -26,6 +26,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "core/plan/cad_holes.h"
 #include "core/types/mesh_groups.h"
 #include "core/types/triangle_mesh.h"
 
@@ -166,6 +167,11 @@ absl::StatusOr<InspectionPlan> ParseInspectionPlan(const nlohmann::json& json,
                                                    const TriangleMesh& part,
                                                    const std::string& where = "plan",
                                                    const MeshGroups& groups = {});
+
+// Plan entries for the CAD's holes (ListHoles), to start a plan from:
+// {"holes": [...], "slots": [...]}, named H1.. and S1.. in list order, with
+// the default tolerances of PlanHole except the true-position zone given.
+nlohmann::json PlanHolesJson(const std::vector<CadHole>& holes, double position_tolerance_mm);
 
 // The plan applied to a mesh: which regions each triangle belongs to, and
 // which comparison points each triangle can reach (a triangle within

@@ -332,4 +332,29 @@ absl::StatusOr<InspectionPlan> ParseInspectionPlan(const json& j, const Triangle
   return plan;
 }
 
+nlohmann::json PlanHolesJson(const std::vector<CadHole>& holes, double position_tolerance_mm) {
+  const PlanHole defaults;
+  auto vec = [](const Eigen::Vector3d& v) { return json{v.x(), v.y(), v.z()}; };
+  auto band = [](const ToleranceBand& b) {
+    return json{{"lower", b.lower_mm}, {"upper", b.upper_mm}};
+  };
+  json out = {{"holes", json::array()}, {"slots", json::array()}};
+  for (const CadHole& h : holes) {
+    json& list = out[h.slot ? "slots" : "holes"];
+    json j = {{"name", absl::StrCat(h.slot ? "S" : "H", list.size() + 1)},
+              {"position_mm", vec(h.position_mm)},
+              {"axis", vec(h.axis)},
+              {"position_tolerance_mm", position_tolerance_mm}};
+    j[h.slot ? "width_mm" : "diameter_mm"] = h.diameter_mm;
+    j[h.slot ? "width_tolerance_mm" : "diameter_tolerance_mm"] = band(defaults.diameter_tolerance);
+    if (h.slot) {
+      j["length_mm"] = h.length_mm;
+      j["direction"] = vec(h.direction);
+      j["length_tolerance_mm"] = band(defaults.length_tolerance);
+    }
+    list.push_back(std::move(j));
+  }
+  return out;
+}
+
 }  // namespace surfinspect

@@ -137,6 +137,7 @@ absl::StatusOr<SectionCut> CutSection(const TriangleMesh& part, const ErrorMapRe
     if ((triangles.empty() || triangles[t]) && CutTriangle(part, t, plane, s))
       segments.push_back(s);
   SectionCut cut;
+  cut.plane = plane;
   cut.segments = segments.size();
   cut.polylines = Chain(segments);
   MeasuredSide(part, em, plane, triangles, max_whiskers, cut);

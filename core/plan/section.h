@@ -36,6 +36,7 @@ struct SectionWhisker {
 };
 
 struct SectionCut {
+  SectionPlane plane;  // as cut (unit normal)
   // The nominal curve: polylines of at least two vertices, each vertex on
   // a mesh edge (or vertex) in the plane.
   std::vector<std::vector<Eigen::Vector3d>> polylines;

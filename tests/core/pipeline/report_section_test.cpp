@@ -39,45 +39,15 @@ SectionCut Cut(const TriangleMesh& mesh, const ErrorMapResult& em, const Eigen::
   return cut.ok() ? *std::move(cut) : SectionCut{};
 }
 
-TEST(ReportSection, ThePlaneOfARealCutIsThePlaneThatCutIt) {
+TEST(ReportSection, ThePlaneIsThePlansAsCut) {
   const TriangleMesh sphere = testing::Icosphere(20, 3);
   const ErrorMapResult em = CentroidMap(sphere);
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> u(-1, 1);
-  for (int trial = 0; trial < 20; ++trial) {
-    const Eigen::Vector3d n = Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized();
-    const Eigen::Vector3d p = 10 * Eigen::Vector3d(u(rng), u(rng), u(rng));
-    const Eigen::Vector3d point = p - (p.dot(n) - 8 * u(rng)) * n;  // |offset| < 8 < radius
-    const SectionCut cut = Cut(sphere, em, point, n);
-    ASSERT_FALSE(cut.polylines.empty()) << trial;
-    const CutPlane plane = PlaneOfCut(cut);
-    // The sign rule: the largest component positive.
-    Eigen::Index largest = 0;
-    n.cwiseAbs().maxCoeff(&largest);
-    const Eigen::Vector3d expected = n[largest] > 0 ? n : Eigen::Vector3d(-n);
-    EXPECT_LT((plane.normal - expected).norm(), 1e-9) << trial;
-    EXPECT_NEAR((plane.point_mm - point).dot(n), 0, 1e-9) << "on the plane, trial " << trial;
-  }
-}
-
-TEST(ReportSection, AStraightCutTakesItsNormalFromTheWhiskers) {
-  // The flat square z = 0 cut by x = 30.5: a straight line along y; the
-  // whiskers (face normal +z) fix the plane x = const.
-  const TriangleMesh square = testing::FlatSquare();
-  const ErrorMapResult em = CentroidMap(square);
-  const SectionCut cut = Cut(square, em, {30.5, 0, 0}, {1, 0, 0}, 10.0);
-  ASSERT_EQ(cut.polylines.size(), 1u);
-  ASSERT_FALSE(cut.whiskers.empty());
-  const CutPlane plane = PlaneOfCut(cut);
-  EXPECT_LT((plane.normal - Eigen::Vector3d::UnitX()).norm(), 1e-12);
-  EXPECT_NEAR(plane.point_mm.x(), 30.5, 1e-12);
-  // Without whiskers the line alone: a unit normal across it.
-  SectionCut bare = cut;
-  bare.whiskers.clear();
-  const CutPlane line = PlaneOfCut(bare);
-  EXPECT_NEAR(line.normal.norm(), 1, 1e-12);
-  EXPECT_NEAR(line.normal.y(), 0, 1e-12) << "orthogonal to the line along y";
-  EXPECT_EQ(PlaneOfCut(SectionCut{}).normal, Eigen::Vector3d::Zero());
+  PlanOutcome outcome;
+  outcome.sections = {Cut(sphere, em, {1, 2, 3}, {0, 0, -2})};
+  const std::vector<ReportSection> s = ReportSectionsOf(outcome);
+  ASSERT_EQ(s.size(), 1u);
+  EXPECT_EQ(s[0].point_mm, Eigen::Vector3d(1, 2, 3));
+  EXPECT_EQ(s[0].normal, Eigen::Vector3d(0, 0, -1)) << "unit, the plan's sign";
 }
 
 // A plan outcome whose characteristics interleave two sections with others.
@@ -122,7 +92,7 @@ TEST(ReportSection, EachCutTakesItsCharacteristicsNameAndBandRoundedToAMicrometr
   EXPECT_EQ(s[0].whiskers.deviation_mm, (std::vector<double>{0.013, -0.25}));
   EXPECT_EQ(s[1].polylines.size(), 0u);
   EXPECT_EQ(s[1].whiskers.size(), 0u);
-  EXPECT_EQ(s[1].normal, Eigen::Vector3d::Zero()) << "nothing to find the plane from";
+  EXPECT_EQ(s[1].normal, Eigen::Vector3d::UnitX()) << "an empty cut keeps its plane";
 }
 
 TEST(ReportSection, TheReportCarriesSectionsAndRoundTripsStructAndBytes) {
