@@ -53,6 +53,20 @@ def page_one_ppm(pdf, work):
     return int(fields[1]), int(fields[2]), data[pos + 1:]
 
 
+def hole_texts(c):
+    """A hole's row: its name, and when measured its size with the deviation
+    and its true position against the zone (core/report/report_content.h)."""
+    if c["verdict"] == "not_measured":
+        return (c["name"],)
+    size, label = ("width", "W") if c["type"] == "slot" else ("diameter", "\u00d8")
+    out = [c["name"], "%s %.3f (%s)" % (label, c["measured_%s_mm" % size],
+                                         fmt_mm(c["%s_deviation_mm" % size])),
+           "TP %.3f / %.3f" % (c["true_position_mm"], c["position_tolerance_mm"])]
+    if c["type"] == "slot":
+        out.append("L %.3f (%s)" % (c["measured_length_mm"], fmt_mm(c["length_deviation_mm"])))
+    return tuple(out)
+
+
 def check_pdf(pdf, report_json, part_id, work):
     with open(report_json) as f:
         report = json.load(f)
@@ -65,7 +79,10 @@ def check_pdf(pdf, report_json, part_id, work):
     assert report["characteristics"], "the demo plan has characteristics"
     for c in report["characteristics"]:
         value = c["value_mm"] if c["type"] == "point" else c["mean_mm"]
-        for want in (c["name"], fmt_mm(value), fmt_mm(c["min_mm"]), fmt_mm(c["max_mm"])):
+        wants = (c["name"], fmt_mm(value), fmt_mm(c["min_mm"]), fmt_mm(c["max_mm"]))
+        if c["type"] in ("hole", "slot"):
+            wants = hole_texts(c)
+        for want in wants:
             if "".join(want.split()) not in flat:
                 problems.append("characteristic %s: missing %r" % (c["name"], want))
     info = tool("pdfinfo", pdf)

@@ -23,36 +23,76 @@ import xml.etree.ElementTree as ET
 NS = {"q": "http://qifstandards.org/xsd/qif3"}
 
 
+def expected_measurements(c):
+    """The QIF characteristics of one report characteristic: (kind, name, value, band)."""
+    if c["type"] not in ("hole", "slot"):
+        kind = "PointProfile" if c["type"] == "point" else "SurfaceProfile"
+        return [(kind, c["name"], None, None)]
+    size = "width" if c["type"] == "slot" else "diameter"
+    out = [(size.capitalize(), c["name"] + " " + size, c.get("measured_%s_mm" % size),
+            c["tolerance_mm"])]
+    if c["type"] == "slot":
+        out.append(("Length", c["name"] + " length", c.get("measured_length_mm"),
+                    c["length_tolerance_mm"]))
+    out.append(("Position", c["name"] + " position", c.get("true_position_mm"),
+                c["position_tolerance_mm"]))
+    return out
+
+
+def check_hole_part(m, definition, c, value, band):
+    """A hole's diameter, width, length or position against the report's hole."""
+    status = m.find("q:Status/q:CharacteristicStatusEnum", NS).text
+    if c["verdict"] == "not_measured":
+        assert status == "INDETERMINATE" and m.find("q:Value", NS) is None, c["name"]
+        return status
+    assert status == "PASS" or c["verdict"] == "fail", (c["name"], status)
+    assert float(m.find("q:Value", NS).text) == value, (c["name"], value)
+    if isinstance(band, dict):
+        assert float(definition.find("q:Tolerance/q:MaxValue", NS).text) == band["upper"]
+        assert float(definition.find("q:Tolerance/q:MinValue", NS).text) == band["lower"]
+    else:
+        assert float(definition.find("q:ToleranceValue", NS).text) == band, c["name"]
+    return status
+
+
 def check_against_report(qif_path, report):
-    """The QIF's characteristics against the report's, in order."""
+    """The QIF's characteristics against the report's, in order (a hole gives
+    a diameter and a position, a slot a width, a length and a position)."""
     root = ET.parse(qif_path).getroot()
     by_id = {e.get("id"): e for e in root.iter() if e.get("id")}
     status = root.find("q:Results/q:MeasurementResultsSet/q:MeasurementResults/q:InspectionStatus/"
                        "q:InspectionStatusEnum", NS).text
     assert status == report["verdict"].upper(), (qif_path, status)
-    measurements = list(root.find(".//q:CharacteristicMeasurements", NS))
+    measurements = iter(root.find(".//q:CharacteristicMeasurements", NS))
     chars = report["characteristics"]
-    assert len(measurements) == len(chars) >= 1, (qif_path, len(measurements), len(chars))
-    for m, c in zip(measurements, chars):
-        kind = "PointProfile" if c["type"] == "point" else "SurfaceProfile"
-        assert m.tag == "{%s}%sCharacteristicMeasurement" % (NS["q"], kind), (m.tag, c["name"])
-        # QIF has no "not measured" characteristic status: INDETERMINATE.
-        expected = "INDETERMINATE" if c["verdict"] == "not_measured" else c["verdict"].upper()
-        assert m.find("q:Status/q:CharacteristicStatusEnum", NS).text == expected, c["name"]
-        item = by_id[m.find("q:CharacteristicItemId", NS).text]
-        assert item.find("q:Name", NS).text == c["name"]
-        definition = by_id[by_id[item.find("q:CharacteristicNominalId", NS).text]
-                           .find("q:CharacteristicDefinitionId", NS).text]
-        lower, upper = c["tolerance_mm"]["lower"], c["tolerance_mm"]["upper"]
-        assert float(definition.find("q:ToleranceValue", NS).text) == upper - lower, c["name"]
-        value = m.find("q:Value", NS)
-        if not c["points"]:
-            assert value is None, c["name"]
-            continue
-        expected = c["value_mm"] if c["type"] == "point" else 2 * max(abs(c["min_mm"]), abs(c["max_mm"]))
-        assert float(value.text) == expected, (c["name"], value.text, expected)
-        assert float(m.find("q:WorstPositiveDeviation", NS).text) == c["max_mm"], c["name"]
-        assert float(m.find("q:WorstNegativeDeviation", NS).text) == c["min_mm"], c["name"]
+    assert chars, qif_path
+    for c in chars:
+        statuses = []
+        for kind, name, value, band in expected_measurements(c):
+            m = next(measurements)
+            assert m.tag == "{%s}%sCharacteristicMeasurement" % (NS["q"], kind), (m.tag, name)
+            item = by_id[m.find("q:CharacteristicItemId", NS).text]
+            assert item.find("q:Name", NS).text == name
+            definition = by_id[by_id[item.find("q:CharacteristicNominalId", NS).text]
+                               .find("q:CharacteristicDefinitionId", NS).text]
+            if band is not None:
+                statuses.append(check_hole_part(m, definition, c, value, band))
+                continue
+            # QIF has no "not measured" characteristic status: INDETERMINATE.
+            expected = "INDETERMINATE" if c["verdict"] == "not_measured" else c["verdict"].upper()
+            assert m.find("q:Status/q:CharacteristicStatusEnum", NS).text == expected, name
+            lower, upper = c["tolerance_mm"]["lower"], c["tolerance_mm"]["upper"]
+            assert float(definition.find("q:ToleranceValue", NS).text) == upper - lower, name
+            value = m.find("q:Value", NS)
+            if not c["points"]:
+                assert value is None, name
+                continue
+            expected = c["value_mm"] if c["type"] == "point" else 2 * max(abs(c["min_mm"]), abs(c["max_mm"]))
+            assert float(value.text) == expected, (name, value.text, expected)
+            assert float(m.find("q:WorstPositiveDeviation", NS).text) == c["max_mm"], name
+            assert float(m.find("q:WorstNegativeDeviation", NS).text) == c["min_mm"], name
+        assert c["verdict"] != "fail" or not statuses or "FAIL" in statuses, c["name"]
+    assert next(measurements, None) is None, "more QIF characteristics than the report's"
     uri = root.find(".//q:ExternalFileReference/q:URI", NS).text
     assert os.path.isfile(os.path.join(os.path.dirname(qif_path), uri)), uri
     return len(chars)
