@@ -146,6 +146,16 @@ absl::StatusOr<InspectionPlan> PlanFromProto(const v1::InspectionPlan& msg,
                      SectionFromProto(msg.sections(i), absl::StrCat(field, ".sections[", i, "]")));
     plan.sections.push_back(std::move(s));
   }
+  for (int i = 0; i < msg.edge_points_size(); ++i) {
+    const v1::PlanEdgePoint& m = msg.edge_points(i);
+    const std::string f = absl::StrCat(field, ".edge_points[", i, "]");
+    PlanEdgePoint e;
+    e.name = m.name();
+    ASSIGN_OR_RETURN(e.position_mm, Vector3FromProto(m.position_mm(), f + ".position_mm"));
+    if (m.has_radius_mm()) e.radius_mm = m.radius_mm();
+    if (m.has_tolerance_mm()) e.tolerance = BandFromProto(m.tolerance_mm());
+    plan.edge_points.push_back(std::move(e));
+  }
   for (int i = 0; i < msg.holes_size(); ++i) {
     ASSIGN_OR_RETURN(auto h, HoleFromProto(msg.holes(i), absl::StrCat(field, ".holes[", i, "]")));
     plan.holes.push_back(std::move(h));
@@ -210,6 +220,13 @@ void PlanToProto(const InspectionPlan& plan, v1::InspectionPlan* msg) {
     m->set_allowed_fraction_outside(s.allowed_fraction_outside);
   }
   for (const PlanHole& h : plan.holes) HoleToProto(h, msg->add_holes());
+  for (const PlanEdgePoint& e : plan.edge_points) {
+    v1::PlanEdgePoint* m = msg->add_edge_points();
+    m->set_name(e.name);
+    Vector3ToProto(e.position_mm, m->mutable_position_mm());
+    m->set_radius_mm(e.radius_mm);
+    BandToProto(e.tolerance, m->mutable_tolerance_mm());
+  }
   if (plan.defects) {
     v1::DefectRules* d = msg->mutable_defects();
     d->set_threshold_mm(plan.defects->threshold_mm);

@@ -95,6 +95,8 @@ v1::CharacteristicType TypeToProto(CharacteristicType t) {
       return v1::CHARACTERISTIC_HOLE;
     case CharacteristicType::kSlot:
       return v1::CHARACTERISTIC_SLOT;
+    case CharacteristicType::kEdgePoint:
+      return v1::CHARACTERISTIC_EDGE_POINT;
   }
   return v1::CHARACTERISTIC_TYPE_UNSPECIFIED;
 }
@@ -192,12 +194,13 @@ CharacteristicsResult CharacteristicsFromProto(
   for (const v1::CharacteristicResult& m : list) {
     CharacteristicResult c;
     c.name = m.name();
-    c.type = m.type() == v1::CHARACTERISTIC_REGION    ? CharacteristicType::kRegion
-             : m.type() == v1::CHARACTERISTIC_POINT   ? CharacteristicType::kPoint
-             : m.type() == v1::CHARACTERISTIC_SECTION ? CharacteristicType::kSection
-             : m.type() == v1::CHARACTERISTIC_HOLE    ? CharacteristicType::kHole
-             : m.type() == v1::CHARACTERISTIC_SLOT    ? CharacteristicType::kSlot
-                                                      : CharacteristicType::kSurface;
+    c.type = m.type() == v1::CHARACTERISTIC_REGION       ? CharacteristicType::kRegion
+             : m.type() == v1::CHARACTERISTIC_POINT      ? CharacteristicType::kPoint
+             : m.type() == v1::CHARACTERISTIC_SECTION    ? CharacteristicType::kSection
+             : m.type() == v1::CHARACTERISTIC_HOLE       ? CharacteristicType::kHole
+             : m.type() == v1::CHARACTERISTIC_SLOT       ? CharacteristicType::kSlot
+             : m.type() == v1::CHARACTERISTIC_EDGE_POINT ? CharacteristicType::kEdgePoint
+                                                         : CharacteristicType::kSurface;
     c.pass = m.verdict() == v1::VERDICT_PASS;
     c.measured = m.verdict() != v1::VERDICT_NOT_MEASURED;
     c.coverage = m.coverage();

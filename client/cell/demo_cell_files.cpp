@@ -101,8 +101,8 @@ double RidgeTopZ(const TriangleMesh& part, double x) {
 // the ridge's band); defect detection with the threshold chosen
 // for the scans' noise (sigma 0.015 mm: 0.03 mm is ~7 sigma of the local
 // median); and every hole and slot the CAD has (ListHoles), H1.. and S1..
-// in its order, with a 0.3 mm true-position zone. The surface keeps the
-// cell's tolerance_mm.
+// in its order, with a 0.3 mm true-position zone; the ridge's trim edge at
+// +x within +-0.5 mm. The surface keeps the cell's tolerance_mm.
 nlohmann::json PlanJson(const DemoCell& cell) {
   const Bounds3 b = ComputeBounds(cell.part);
   nlohmann::json holes = PlanHolesJson(ListHoles(cell.part), 0.3);
@@ -133,6 +133,10 @@ nlohmann::json PlanJson(const DemoCell& cell) {
          {"allowed_fraction_outside", 0.001}}}},
       {"holes", holes["holes"]},
       {"slots", holes["slots"]},
+      {"edge_points",
+       {{{"name", "trim-x+"},
+         {"position_mm", {b.max.x(), 0.0, RidgeTopZ(cell.part, b.max.x())}},
+         {"tolerance_mm", {{"lower", -0.5}, {"upper", 0.5}}}}}},
       {"defects", {{"threshold_mm", 0.03}, {"min_area_mm2", 3.0}}}};
 }
 

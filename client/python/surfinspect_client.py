@@ -261,13 +261,18 @@ def read_cell(path):
 _PLAN_KEYS = {
     "plan": {"schema", "tolerance_mm", "allowed_fraction_outside", "min_coverage",
              "coverage_distance_mm", "allow_not_measured", "regions", "points", "sections",
-             "defects"},
+             "holes", "slots", "edge_points", "defects"},
     "region": {"name", "select", "tolerance_mm", "allowed_fraction_outside", "min_coverage"},
     "select": {"box_mm", "triangles", "group"},
     "point": {"name", "position_mm", "normal", "direction", "radius_mm", "tolerance_mm",
               "min_coverage"},
     "section": {"name", "point_mm", "normal", "width_mm", "region", "tolerance_mm",
                 "allowed_fraction_outside"},
+    "hole": {"name", "position_mm", "axis", "diameter_mm", "position_tolerance_mm",
+             "diameter_tolerance_mm", "min_arc_deg"},
+    "slot": {"name", "position_mm", "axis", "direction", "width_mm", "length_mm",
+             "position_tolerance_mm", "width_tolerance_mm", "length_tolerance_mm", "min_arc_deg"},
+    "edge_point": {"name", "position_mm", "radius_mm", "tolerance_mm"},
     "defects": {"threshold_mm", "min_area_mm2", "max_count"},
     "band": {"lower", "upper"},
 }
@@ -368,6 +373,47 @@ def _sections(plan, msg):
             _band(c["tolerance_mm"], m.tolerance_mm, where + ".tolerance_mm")
 
 
+def _holes(plan, msg):
+    """Holes, then slots, as the C++ parser orders them (PlanHole.slot)."""
+    for kind, size in (("hole", "diameter"), ("slot", "width")):
+        for i, h in enumerate(plan.get(kind + "s", [])):
+            where = f"plan.{kind}s[{i}]"
+            _keys(h, kind, where)
+            required = ["position_mm", "axis", size + "_mm"]
+            required += ["length_mm", "direction"] if kind == "slot" else []
+            for key in required:
+                if key not in h:
+                    raise ClientError(f"{where}.{key}: missing")
+            m = msg.holes.add(name=str(h.get("name", "")), slot=kind == "slot")
+            m.position_mm.extend(_vector3(h.get("position_mm"), where + ".position_mm"))
+            m.axis.extend(_vector3(h.get("axis"), where + ".axis"))
+            m.diameter_mm = _number(h, size + "_mm", where)
+            for key in ("position_tolerance_mm", "min_arc_deg"):
+                if key in h:
+                    setattr(m, key, _number(h, key, where))
+            if size + "_tolerance_mm" in h:
+                _band(h[size + "_tolerance_mm"], m.diameter_tolerance_mm,
+                      f"{where}.{size}_tolerance_mm")
+            if kind == "slot":
+                m.length_mm = _number(h, "length_mm", where)
+                m.direction.extend(_vector3(h.get("direction"), where + ".direction"))
+                if "length_tolerance_mm" in h:
+                    _band(h["length_tolerance_mm"], m.length_tolerance_mm,
+                          where + ".length_tolerance_mm")
+
+
+def _edge_points(plan, msg):
+    for i, e in enumerate(plan.get("edge_points", [])):
+        where = f"plan.edge_points[{i}]"
+        _keys(e, "edge_point", where)
+        m = msg.edge_points.add(name=str(e.get("name", "")))
+        m.position_mm.extend(_vector3(e.get("position_mm"), where + ".position_mm"))
+        if "radius_mm" in e:
+            m.radius_mm = _number(e, "radius_mm", where)
+        if "tolerance_mm" in e:
+            _band(e["tolerance_mm"], m.tolerance_mm, where + ".tolerance_mm")
+
+
 def plan_proto(plan):
     """The JSON plan as the typed InspectionPlan message. Keys and shapes are
     checked here, naming the field; the server checks the values against the
@@ -386,6 +432,8 @@ def plan_proto(plan):
     _regions(plan, msg)
     _points(plan, msg)
     _sections(plan, msg)
+    _holes(plan, msg)
+    _edge_points(plan, msg)
     if "defects" in plan:
         d = plan["defects"]
         _keys(d, "defects", "plan.defects")

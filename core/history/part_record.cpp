@@ -22,7 +22,7 @@ absl::Status FillFromReportJson(const std::string& text, const std::string& wher
     r.min_mm = c.min_mm;
     r.max_mm = c.max_mm;
     r.stddev_mm = c.stddev_mm;
-    r.value_mm = c.is_point() ? c.value_mm : c.mean_mm;
+    r.value_mm = c.has_value() ? c.value_mm : c.mean_mm;
     r.lower_mm = c.tolerance.lower_mm;
     r.upper_mm = c.tolerance.upper_mm;
     r.points = static_cast<int64_t>(c.points);

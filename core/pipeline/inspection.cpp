@@ -41,9 +41,10 @@ absl::StatusOr<InspectionResult> InspectPart(const MeshIndex& part,
       ComputeErrorMap(part, out.merged.cloud_in_world, world_from_part, settings.error_map, cancel);
   if (!map.ok()) return map.status();
   out.error_map = *std::move(map);
-  // The views as the plan measures holes on them: filtered, in the part frame.
+  // The views as the plan measures holes and edges on them: filtered, in the
+  // part frame.
   std::vector<PlanView> plan_views;
-  if (settings.plan && !settings.plan->holes.empty())
+  if (settings.plan && (!settings.plan->holes.empty() || !settings.plan->edge_points.empty()))
     for (const ViewScan& v : views)
       plan_views.push_back(
           {v.name, &v.cloud_in_sensor, world_from_part.inverse() * v.world_from_sensor});

@@ -49,7 +49,7 @@ void VisitCharacteristic(V& v, R& c) {
   v("stddev_mm", c.stddev_mm);
   v("rms_mm", c.rms_mm);
   v("fraction_within", c.fraction_within);
-  if (c.is_point())
+  if (c.has_value())
     v("value_mm", c.value_mm);
   else if (c.is_hole())
     VisitHole(v, c);

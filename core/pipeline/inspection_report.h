@@ -62,7 +62,7 @@ struct ReportCharacteristic {
   std::size_t points = 0;  // matched points judged
   double min_mm = NAN, max_mm = NAN, mean_mm = NAN, stddev_mm = NAN, rms_mm = NAN;
   double fraction_within = NAN;
-  double value_mm = NAN;                  // points only
+  double value_mm = NAN;                  // points and edge points only
   double allowed_fraction_outside = NAN;  // surface and regions only
   // Holes and slots (core/plan/holes.h): the measured centre in the plan
   // plane, its deviation from the nominal, the true position and its zone;
@@ -77,6 +77,7 @@ struct ReportCharacteristic {
   ToleranceBand length_tolerance{NAN, NAN};
   double form_mm = NAN, arc_coverage_deg = NAN, pixel_pitch_mm = NAN;
   bool is_point() const { return type == "point"; }
+  bool has_value() const { return type == "point" || type == "edge_point"; }  // value_mm
   bool is_hole() const { return type == "hole" || type == "slot"; }
   bool passed() const { return verdict == "pass"; }
   bool measured() const { return verdict != "not_measured"; }

@@ -151,4 +151,37 @@ std::vector<CadHole> ListHoles(const TriangleMesh& mesh, const CadHoleSettings& 
   return holes;
 }
 
+std::optional<CadEdge> NearestBoundaryEdge(const TriangleMesh& mesh, const Eigen::Vector3d& p) {
+  const std::vector<EdgeUse> uses = SortedEdgeUses(mesh);
+  std::optional<CadEdge> best;
+  for (std::size_t i = 0; i < uses.size(); ++i) {
+    if ((i > 0 && uses[i - 1].edge == uses[i].edge) ||
+        (i + 1 < uses.size() && uses[i + 1].edge == uses[i].edge))
+      continue;
+    const Triangle& t = mesh.triangles[uses[i].triangle];
+    const auto lo = static_cast<uint32_t>(uses[i].edge >> 32);
+    const auto hi = static_cast<uint32_t>(uses[i].edge);
+    const Eigen::Vector3d a = mesh.vertices[lo].cast<double>(),
+                          b = mesh.vertices[hi].cast<double>();
+    const double len2 = (b - a).squaredNorm();
+    if (!(len2 > 0)) continue;
+    const double u = std::clamp((p - a).dot(b - a) / len2, 0.0, 1.0);
+    const Eigen::Vector3d on = a + u * (b - a);
+    if (best && (p - on).norm() >= best->distance_mm) continue;
+    const uint32_t third = t[0] != lo && t[0] != hi ? t[0] : t[1] != lo && t[1] != hi ? t[1] : t[2];
+    const Eigen::Vector3d c = mesh.vertices[third].cast<double>();
+    CadEdge e;
+    e.point_mm = on;
+    e.tangent = (b - a).normalized();
+    e.normal = (mesh.vertices[t[1]].cast<double>() - mesh.vertices[t[0]].cast<double>())
+                   .cross(mesh.vertices[t[2]].cast<double>() - mesh.vertices[t[0]].cast<double>())
+                   .normalized();
+    e.outward = e.tangent.cross(e.normal);
+    if (e.outward.dot(c - a) > 0) e.outward = -e.outward;
+    e.distance_mm = (p - on).norm();
+    if (e.normal.allFinite()) best = e;
+  }
+  return best;
+}
+
 }  // namespace surfinspect

@@ -5,11 +5,12 @@
 // out. A STEP solid's holes are closed cylinder walls, not boundary loops:
 // they are not found here (docs/inspection-plan.md#holes-and-slots).
 //
-// Units mm, part frame.
+// Units mm, part frame. NearestBoundaryEdge gives the trim edge at a point.
 #pragma once
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "core/types/triangle_mesh.h"
@@ -54,5 +55,17 @@ struct CadHoleSettings {
 // Sorted by position (x, then y, then z) so the list reads the same for the
 // same mesh.
 std::vector<CadHole> ListHoles(const TriangleMesh& mesh, const CadHoleSettings& settings = {});
+
+// The CAD's boundary (a trim edge) at a point: the nearest boundary edge
+// (used by one triangle), the point on it, its direction, its triangle's
+// normal and the direction in that triangle's plane off the material.
+struct CadEdge {
+  Eigen::Vector3d point_mm = Eigen::Vector3d::Zero();
+  Eigen::Vector3d tangent = Eigen::Vector3d::UnitX(), normal = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d outward = Eigen::Vector3d::UnitY();
+  double distance_mm = 0;  // from the point asked about
+};
+// None for a closed mesh (no boundary).
+std::optional<CadEdge> NearestBoundaryEdge(const TriangleMesh& mesh, const Eigen::Vector3d& p);
 
 }  // namespace surfinspect

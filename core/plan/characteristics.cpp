@@ -251,6 +251,25 @@ CharacteristicResult JudgeHole(const PlanHole& h, const HoleMeasurement& m) {
   return c;
 }
 
+CharacteristicResult JudgeEdgePoint(const PlanEdgePoint& e, const EdgePointMeasurement& m) {
+  CharacteristicResult c;
+  c.name = e.name;
+  c.type = CharacteristicType::kEdgePoint;
+  c.tolerance = e.tolerance;
+  c.points = m.points;
+  c.value_mm = m.value_mm;
+  if (!m.measured) {
+    c.measured = false;
+    c.reason = "not measured: " + m.reason;
+    return c;
+  }
+  c.pass = e.tolerance.Contains(float(m.value_mm));
+  c.reason = absl::StrFormat("%s: edge %+.3f mm %s [%+.3g, %+.3g] (%u edge points)",
+                             c.pass ? "pass" : "fail", m.value_mm, c.pass ? "within" : "outside",
+                             e.tolerance.lower_mm, e.tolerance.upper_mm, m.points);
+  return c;
+}
+
 }  // namespace
 
 const char* VerdictName(const CharacteristicResult& c) {
@@ -271,6 +290,8 @@ const char* CharacteristicTypeName(CharacteristicType type) {
       return "hole";
     case CharacteristicType::kSlot:
       return "slot";
+    case CharacteristicType::kEdgePoint:
+      return "edge_point";
   }
   return "surface";
 }
@@ -278,12 +299,14 @@ const char* CharacteristicTypeName(CharacteristicType type) {
 absl::StatusOr<CharacteristicsResult> ComputeCharacteristics(
     const ErrorMapResult& em, const ResolvedInspectionPlan& rp, std::size_t defect_count,
     const CharacteristicsSettings& settings, const CoverageResult* coverage,
-    const std::vector<SectionCut>& sections, const std::vector<HoleMeasurement>& holes) {
+    const std::vector<SectionCut>& sections, const std::vector<HoleMeasurement>& holes,
+    const std::vector<EdgePointMeasurement>& edge_points) {
   const std::size_t n = em.deviation_mm.size();
   if (sections.size() != rp.plan.sections.size())
     return absl::InvalidArgumentError("characteristics: one cut per section of the plan");
-  if (holes.size() != rp.plan.holes.size())
-    return absl::InvalidArgumentError("characteristics: one measurement per hole of the plan");
+  if (holes.size() != rp.plan.holes.size() || edge_points.size() != rp.plan.edge_points.size())
+    return absl::InvalidArgumentError(
+        "characteristics: one measurement per hole and edge point of the plan");
   if (coverage && (coverage->regions.size() != rp.plan.regions.size() ||
                    coverage->points.size() != rp.plan.points.size()))
     return absl::InvalidArgumentError("characteristics: the coverage is of another plan");
@@ -326,6 +349,12 @@ absl::StatusOr<CharacteristicsResult> ComputeCharacteristics(
   }
   for (std::size_t h = 0; h < holes.size(); ++h) {
     CharacteristicResult c = JudgeHole(rp.plan.holes[h], holes[h]);
+    out.failed += !c.pass && c.measured;
+    out.not_measured += !c.measured;
+    out.characteristics.push_back(std::move(c));
+  }
+  for (std::size_t e = 0; e < edge_points.size(); ++e) {
+    CharacteristicResult c = JudgeEdgePoint(rp.plan.edge_points[e], edge_points[e]);
     out.failed += !c.pass && c.measured;
     out.not_measured += !c.measured;
     out.characteristics.push_back(std::move(c));

@@ -10,6 +10,8 @@
 //  * A hole or slot passes when it was measured (its edge seen over at
 //    least min_arc_deg), its true position is within its zone and its
 //    diameter (a slot's width and length) deviates within its band.
+//  * An edge point passes when it was measured and its offset is inside
+//    its band.
 //  * A surface, region or section passes when it has matched points and
 //    the fraction outside its band is at most allowed_fraction_outside
 //    (a section's points are those CutSection selected); a point passes
@@ -35,14 +37,15 @@
 #include "absl/status/statusor.h"
 #include "core/errormap/error_map.h"
 #include "core/plan/coverage.h"
+#include "core/plan/edge_points.h"
 #include "core/plan/holes.h"
 #include "core/plan/inspection_plan.h"
 #include "core/plan/section.h"
 
 namespace surfinspect {
 
-enum class CharacteristicType { kSurface, kRegion, kPoint, kSection, kHole, kSlot };
-// "surface" | "region" | "point" | "section" | "hole" | "slot"
+enum class CharacteristicType { kSurface, kRegion, kPoint, kSection, kHole, kSlot, kEdgePoint };
+// "surface" | "region" | "point" | "section" | "hole" | "slot" | "edge_point"
 const char* CharacteristicTypeName(CharacteristicType type);
 
 struct CharacteristicResult {
@@ -60,7 +63,9 @@ struct CharacteristicResult {
   // Over those points, mm; NaN when there are none. stddev is the population one.
   double min_mm = NAN, max_mm = NAN, mean_mm = NAN, stddev_mm = NAN, rms_mm = NAN;
   double fraction_within = NAN;
-  double value_mm = NAN;  // points only: the mean; NaN when no point is near
+  // Points: the mean; NaN when no point is near. Edge points: the edge's
+  // offset across the CAD edge, + off the material.
+  double value_mm = NAN;
   // Holes and slots: the measurement (core/plan/holes.h) and the true
   // position zone it was judged against; `tolerance` is the diameter's (a
   // slot's width's) band, `points` the edge points kept by the fit.
@@ -73,7 +78,7 @@ struct CharacteristicResult {
 };
 
 struct CharacteristicsResult {
-  // surface, regions, points, sections, holes (then slots), in plan order
+  // surface, regions, points, sections, holes and slots, edge points, in plan order
   std::vector<CharacteristicResult> characteristics;
   bool pass = false;       // every characteristic passes (and the defect count rule, when set)
   std::size_t failed = 0;  // characteristics that were measured and fail
@@ -94,11 +99,13 @@ const char* VerdictName(const CharacteristicResult& c);
 // `coverage` (of the same plan and map) is judged when given. `sections`
 // holds the plan's sections cut on the same map (CutSection), one per
 // plan.sections entry; each is judged like a region on its points.
-// `holes` holds one measurement per plan.holes entry (MeasureHoles).
+// `holes` holds one measurement per plan.holes entry (MeasureHoles),
+// `edge_points` one per plan.edge_points entry (MeasureEdgePoints).
 absl::StatusOr<CharacteristicsResult> ComputeCharacteristics(
     const ErrorMapResult& error_map, const ResolvedInspectionPlan& plan,
     std::size_t defect_count = 0, const CharacteristicsSettings& settings = {},
     const CoverageResult* coverage = nullptr, const std::vector<SectionCut>& sections = {},
-    const std::vector<HoleMeasurement>& holes = {});
+    const std::vector<HoleMeasurement>& holes = {},
+    const std::vector<EdgePointMeasurement>& edge_points = {});
 
 }  // namespace surfinspect

@@ -5,6 +5,7 @@
 #include <set>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "core/distance/point_triangle.h"
 #include "core/plan/cad_holes.h"
 #include "core/types/status_macros.h"
@@ -71,8 +72,8 @@ absl::Status CheckName(const std::string& path, const std::string& name,
   if (name == kSurfaceCharacteristicName)
     return Bad(path, "\"surface\" is reserved for the whole surface");
   if (!seen.insert(name).second)
-    return Bad(path, absl::StrCat("duplicate name \"", name,
-                                  "\" (regions and points share one namespace)"));
+    return Bad(path,
+               absl::StrCat("duplicate name \"", name, "\" (characteristics share one namespace)"));
   return absl::OkStatus();
 }
 
@@ -204,6 +205,28 @@ absl::Status CheckHoles(const InspectionPlan& plan, const TriangleMesh& part,
   return absl::OkStatus();
 }
 
+// An edge point needs a CAD boundary within its radius.
+absl::Status CheckEdgePoints(const InspectionPlan& plan, const TriangleMesh& part,
+                             const std::string& where, std::set<std::string>& names) {
+  for (std::size_t k = 0; k < plan.edge_points.size(); ++k) {
+    const PlanEdgePoint& e = plan.edge_points[k];
+    const std::string path = Index(where + ".edge_points", k);
+    RETURN_IF_ERROR(CheckName(path + ".name", e.name, names));
+    if (!e.position_mm.allFinite()) return Bad(path + ".position_mm", "not a finite number");
+    RETURN_IF_ERROR(CheckFinite(path + ".radius_mm", e.radius_mm));
+    if (!(e.radius_mm > 0)) return Bad(path + ".radius_mm", "must be > 0");
+    RETURN_IF_ERROR(CheckBand(path + ".tolerance_mm", e.tolerance));
+    const std::optional<CadEdge> edge = NearestBoundaryEdge(part, e.position_mm);
+    if (!edge || edge->distance_mm > e.radius_mm)
+      return Bad(path + ".position_mm",
+                 edge
+                     ? absl::StrFormat("the CAD's boundary is %.1f mm away, farther than radius_mm",
+                                       edge->distance_mm)
+                     : std::string("the CAD has no boundary (a closed mesh)"));
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
 
 absl::Status ValidateInspectionPlan(const InspectionPlan& plan, const TriangleMesh& part,
@@ -245,6 +268,7 @@ absl::Status ValidateInspectionPlan(const InspectionPlan& plan, const TriangleMe
   }
   RETURN_IF_ERROR(CheckSections(plan, part, where, names));
   RETURN_IF_ERROR(CheckHoles(plan, part, where, names));
+  RETURN_IF_ERROR(CheckEdgePoints(plan, part, where, names));
   if (plan.defects) {
     const std::string path = where + ".defects";
     const DefectRules& d = *plan.defects;

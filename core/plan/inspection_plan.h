@@ -120,6 +120,17 @@ struct PlanHole {
   double min_arc_deg = kDefaultMinArcDeg;               // seen over less: not measured
 };
 
+// A point on the CAD's trim edge (its boundary: an edge used by one
+// triangle), judged on where the measured edge lies across the nominal one
+// in the face's plane (core/plan/edge_points.h): + off the material (the
+// sheet reaches farther than drawn), - into it.
+struct PlanEdgePoint {
+  std::string name;
+  Eigen::Vector3d position_mm = Eigen::Vector3d::Zero();  // on or near the boundary, part frame
+  double radius_mm = 5.0;                                 // sampled within +-radius along the edge
+  ToleranceBand tolerance{-0.5, 0.5};
+};
+
 struct DefectRules {
   double threshold_mm = 0.05;  // |robust local deviation| above this is defective; > 0
   double min_area_mm2 = 3.0;   // smaller patches are not reported; >= 0
@@ -147,7 +158,8 @@ struct InspectionPlan {
   std::vector<PlanRegion> regions;
   std::vector<ComparisonPoint> points;
   std::vector<PlanSection> sections;
-  std::vector<PlanHole> holes;         // holes, then slots, in plan order
+  std::vector<PlanHole> holes;  // holes, then slots, in plan order
+  std::vector<PlanEdgePoint> edge_points;
   std::optional<DefectRules> defects;  // unset: no defect detection
 };
 

@@ -251,6 +251,20 @@ absl::StatusOr<PlanHole> Slot(const json& j, const std::string& path) {
   return h;
 }
 
+absl::StatusOr<PlanEdgePoint> EdgePoint(const json& j, const std::string& path) {
+  RETURN_IF_ERROR(CheckKeys(j, path, {"name", "position_mm", "radius_mm", "tolerance_mm"}));
+  PlanEdgePoint e;
+  for (const char* key : {"name", "position_mm"})
+    if (!j.contains(key)) return Bad(absl::StrCat(path, ".", key), "missing");
+  ASSIGN_OR_RETURN(e.name, String(j["name"], path + ".name"));
+  ASSIGN_OR_RETURN(e.position_mm, Vector3(j["position_mm"], path + ".position_mm"));
+  RETURN_IF_ERROR(OptionalNumber(j, "radius_mm", path, e.radius_mm));
+  if (j.contains("tolerance_mm")) {
+    ASSIGN_OR_RETURN(e.tolerance, Band(j["tolerance_mm"], path + ".tolerance_mm"));
+  }
+  return e;
+}
+
 absl::StatusOr<DefectRules> Defects(const json& j, const std::string& path) {
   if (auto st = CheckKeys(j, path, {"threshold_mm", "min_area_mm2", "max_count"}); !st.ok())
     return st;
@@ -290,7 +304,7 @@ absl::StatusOr<InspectionPlan> ParseInspectionPlan(const json& j, const Triangle
   if (auto st = CheckKeys(j, where,
                           {"schema", "tolerance_mm", "allowed_fraction_outside", "min_coverage",
                            "coverage_distance_mm", "allow_not_measured", "regions", "points",
-                           "sections", "holes", "slots", "defects"});
+                           "sections", "holes", "slots", "edge_points", "defects"});
       !st.ok())
     return st;
   InspectionPlan plan;
@@ -324,6 +338,8 @@ absl::StatusOr<InspectionPlan> ParseInspectionPlan(const json& j, const Triangle
   // Holes, then slots: ValidateInspectionPlan names plan.holes[k] by that order.
   if (j.contains("holes")) RETURN_IF_ERROR(List(j["holes"], where + ".holes", Hole, plan.holes));
   if (j.contains("slots")) RETURN_IF_ERROR(List(j["slots"], where + ".slots", Slot, plan.holes));
+  if (j.contains("edge_points"))
+    RETURN_IF_ERROR(List(j["edge_points"], where + ".edge_points", EdgePoint, plan.edge_points));
   if (j.contains("defects")) {
     ASSIGN_OR_RETURN(auto d, Defects(j["defects"], where + ".defects"));
     plan.defects = d;

@@ -103,12 +103,14 @@ absl::StatusOr<PlanOutcome> EvaluatePlan(const ErrorMapResult& error_map, const 
   }
   ASSIGN_OR_RETURN(out.sections, CutSections(error_map, part, resolved));
   ASSIGN_OR_RETURN(auto holes, MeasureHoles(resolved.plan.holes, views, {}, cancel));
+  ASSIGN_OR_RETURN(auto edges,
+                   MeasureEdgePoints(resolved.plan.edge_points, part, views, {}, cancel));
   CharacteristicsSettings cs;
   cs.threads = threads;
-  ASSIGN_OR_RETURN(
-      out.characteristics,
-      ComputeCharacteristics(error_map, resolved, out.defects.defects.size(), cs,
-                             out.coverage_run ? &out.coverage : nullptr, out.sections, holes));
+  ASSIGN_OR_RETURN(out.characteristics,
+                   ComputeCharacteristics(error_map, resolved, out.defects.defects.size(), cs,
+                                          out.coverage_run ? &out.coverage : nullptr, out.sections,
+                                          holes, edges));
   return out;
 }
 

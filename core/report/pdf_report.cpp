@@ -309,7 +309,7 @@ absl::StatusOr<std::string> RenderPdfReport(const PdfReportInput& in) {
   // One width per column of CharacteristicHeader(), kWidth in all.
   DrawTable(p, "Characteristics (failed first)", c.characteristics,
             {88, 32, 40, 78, 78, 40, 40, 42, 35, 42});
-  DrawTable(p, "Defects", c.defects, {30, 32, 118, 50, 50, 50, 45, 140});
+  DrawTable(p, "Defects", c.defects, {30, 32, 88, 45, 40, 45, 45, 45, 135});
   DrawSections(p, *in.report, c);
   return p.canvas.Finish();
 }

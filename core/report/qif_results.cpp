@@ -82,18 +82,21 @@ std::string CharacteristicStatus(const std::string& verdict) {
 absl::Status AddProfile(const ReportCharacteristic& c, const std::string& where,
                         std::vector<QifCharacteristic>& out) {
   QifCharacteristic q;
-  q.kind = c.is_point() ? "PointProfile" : "SurfaceProfile";
+  // A trim-edge point is one offset: a point profile whose worst values are
+  // that offset.
+  const bool edge = c.type == "edge_point";
+  q.kind = c.has_value() ? "PointProfile" : "SurfaceProfile";
   q.name = c.name;
   q.status = CharacteristicStatus(c.verdict);
   q.description = c.reason;
   q.lower = c.tolerance.lower_mm;
   q.upper = c.tolerance.upper_mm;
-  q.has_values = c.points > 0 && std::isfinite(c.min_mm);
+  q.has_values = edge ? std::isfinite(c.value_mm) : c.points > 0 && std::isfinite(c.min_mm);
   if (q.has_values) {
-    q.worst_negative = c.min_mm;
-    q.worst_positive = c.max_mm;
+    q.worst_negative = edge ? c.value_mm : c.min_mm;
+    q.worst_positive = edge ? c.value_mm : c.max_mm;
     // A surface profile's value is the zone width 2 max(|min|, |max|).
-    q.value = c.is_point() ? c.value_mm : 2.0 * std::max(std::abs(c.min_mm), std::abs(c.max_mm));
+    q.value = c.has_value() ? c.value_mm : 2.0 * std::max(std::abs(c.min_mm), std::abs(c.max_mm));
     if (!std::isfinite(q.worst_positive) || !std::isfinite(q.value))
       return absl::InvalidArgumentError(absl::StrCat(where, ": points without values"));
   }
@@ -159,7 +162,8 @@ absl::Status AddCharacteristic(const ReportCharacteristic& c, std::size_t k,
   if (c.verdict != "pass" && c.verdict != "fail" && c.verdict != "not_measured")
     return absl::InvalidArgumentError(absl::StrCat(where, ".verdict: not pass/fail/not_measured"));
   if (c.is_hole()) return AddHole(c, where, out);
-  if (c.type != "surface" && c.type != "region" && c.type != "point" && c.type != "section")
+  if (c.type != "surface" && c.type != "region" && c.type != "point" && c.type != "section" &&
+      c.type != "edge_point")
     return absl::InvalidArgumentError(absl::StrCat(where, ".type: unknown \"", c.type, "\""));
   return AddProfile(c, where, out);
 }

@@ -123,7 +123,7 @@ std::vector<std::string> CharacteristicRow(const ReportCharacteristic& c) {
           c.type,
           c.verdict,
           Band(c.tolerance),
-          FormatMm(c.is_point() ? c.value_mm : c.mean_mm),
+          FormatMm(c.has_value() ? c.value_mm : c.mean_mm),
           FormatMm(c.min_mm),
           FormatMm(c.max_mm),
           Percent(c.fraction_within),

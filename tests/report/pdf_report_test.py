@@ -78,10 +78,12 @@ def check_pdf(pdf, report_json, part_id, work):
             problems.append("missing %r" % want)
     assert report["characteristics"], "the demo plan has characteristics"
     for c in report["characteristics"]:
-        value = c["value_mm"] if c["type"] == "point" else c["mean_mm"]
+        value = c["value_mm"] if c["type"] in ("point", "edge_point") else c["mean_mm"]
         wants = (c["name"], fmt_mm(value), fmt_mm(c["min_mm"]), fmt_mm(c["max_mm"]))
         if c["type"] in ("hole", "slot"):
             wants = hole_texts(c)
+        elif c["type"] == "edge_point":  # one offset, no min or max
+            wants = (c["name"], fmt_mm(value)) if c["verdict"] != "not_measured" else (c["name"],)
         for want in wants:
             if "".join(want.split()) not in flat:
                 problems.append("characteristic %s: missing %r" % (c["name"], want))

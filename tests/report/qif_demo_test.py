@@ -26,7 +26,7 @@ NS = {"q": "http://qifstandards.org/xsd/qif3"}
 def expected_measurements(c):
     """The QIF characteristics of one report characteristic: (kind, name, value, band)."""
     if c["type"] not in ("hole", "slot"):
-        kind = "PointProfile" if c["type"] == "point" else "SurfaceProfile"
+        kind = "PointProfile" if c["type"] in ("point", "edge_point") else "SurfaceProfile"
         return [(kind, c["name"], None, None)]
     size = "width" if c["type"] == "slot" else "diameter"
     out = [(size.capitalize(), c["name"] + " " + size, c.get("measured_%s_mm" % size),
@@ -87,10 +87,13 @@ def check_against_report(qif_path, report):
             if not c["points"]:
                 assert value is None, name
                 continue
-            expected = c["value_mm"] if c["type"] == "point" else 2 * max(abs(c["min_mm"]), abs(c["max_mm"]))
+            expected = (c["value_mm"] if c["type"] in ("point", "edge_point")
+                        else 2 * max(abs(c["min_mm"]), abs(c["max_mm"])))
             assert float(value.text) == expected, (name, value.text, expected)
-            assert float(m.find("q:WorstPositiveDeviation", NS).text) == c["max_mm"], name
-            assert float(m.find("q:WorstNegativeDeviation", NS).text) == c["min_mm"], name
+            worst = (c["value_mm"], c["value_mm"]) if c["type"] == "edge_point" else (
+                c["max_mm"], c["min_mm"])
+            assert float(m.find("q:WorstPositiveDeviation", NS).text) == worst[0], name
+            assert float(m.find("q:WorstNegativeDeviation", NS).text) == worst[1], name
         assert c["verdict"] != "fail" or not statuses or "FAIL" in statuses, c["name"]
     assert next(measurements, None) is None, "more QIF characteristics than the report's"
     uri = root.find(".//q:ExternalFileReference/q:URI", NS).text

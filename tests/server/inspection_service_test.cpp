@@ -565,6 +565,23 @@ TEST(InspectionService, BadRequestsGetTheRightCodeAndTheServerStaysUp) {
   v1::InspectRequest no_selector = part_msg;
   no_selector.mutable_part()->mutable_plan()->add_regions()->set_name("r");
   plans.push_back({raw.Inspect({no_selector}), "part.plan.regions[0].select"});
+  v1::ErrorMapRequest nowhere = em;  // the demo part has no hole at the ridge's middle
+  v1::PlanHole* hole = nowhere.mutable_plan()->add_holes();
+  hole->set_name("h");
+  for (double v : {0.0, 0.0, 60.0}) hole->add_position_mm(v);
+  for (double v : {0.0, 0.0, 1.0}) hole->add_axis(v);
+  hole->set_diameter_mm(8);
+  plans.push_back({errormap(nowhere), "plan.holes[0].position_mm"});
+  v1::ErrorMapRequest no_axis = em;
+  v1::PlanHole* flat = no_axis.mutable_plan()->add_holes();
+  for (double v : {-110.0, 0.0, 58.4}) flat->add_position_mm(v);
+  for (double v : {0.0, 0.0, 0.0}) flat->add_axis(v);
+  plans.push_back({errormap(no_axis), "plan.holes[0].axis"});
+  v1::ErrorMapRequest far_edge = em;
+  v1::PlanEdgePoint* edge = far_edge.mutable_plan()->add_edge_points();
+  edge->set_name("e");
+  for (double v : {0.0, 0.0, 60.0}) edge->add_position_mm(v);
+  plans.push_back({errormap(far_edge), "plan.edge_points[0].position_mm"});
   for (const auto& [st, field] : plans) {
     EXPECT_EQ(st.error_code(), StatusCode::INVALID_ARGUMENT) << field << ": " << st.error_message();
     EXPECT_NE(st.error_message().find(field), std::string::npos) << st.error_message();

@@ -47,6 +47,12 @@ CellConfig SmallCell(const std::string& dir) {
   // drift and the defects are all within 1 mm.
   j["error_map"]["max_distance_mm"] = 1.0;
   EXPECT_TRUE(WriteStringAtomically(dir + "/cell.json", j.dump(2)).ok());
+  // The drift is on the surface. At this pitch (2 mm) the demo's 5-12 mm
+  // holes are a few pixels across, below what their edges resolve: the plan
+  // judges the surface, its regions, points and section only.
+  nlohmann::json plan = nlohmann::json::parse(std::ifstream(dir + "/plan.json"));
+  for (const char* key : {"holes", "slots", "edge_points"}) plan.erase(key);
+  EXPECT_TRUE(WriteStringAtomically(dir + "/plan.json", plan.dump(2)).ok());
   auto cell = ReadCellConfig(dir + "/cell.json");
   EXPECT_TRUE(cell.ok()) << cell.status();
   return *cell;

@@ -9,6 +9,7 @@
 #include <functional>
 #include <nlohmann/json.hpp>
 
+#include "core/simulation/pillar.h"
 #include "tests/support/test_meshes.h"
 
 namespace surfinspect {
@@ -209,6 +210,56 @@ TEST(InspectionPlan, ResolvesMembershipAgainstBruteForce) {
                                      r->point_ids.begin() + r->point_offsets[t + 1], p) > 0;
       EXPECT_EQ(listed, d <= plan->points[p].radius_mm) << "triangle " << t << " point " << p;
     }
+}
+
+// Holes, slots and edge points on the pillar that has them: the entries
+// `surfinspect holes --plan` prints parse; each bad value is refused naming
+// its field.
+TEST(InspectionPlan, HolesSlotsAndEdgePointsAreCheckedAgainstTheCad) {
+  const TriangleMesh part = MakePillarMesh(300, DemoPillarFeatures());
+  json j = PlanHolesJson(ListHoles(part), 0.25);
+  j["edge_points"] = {{{"name", "end"}, {"position_mm", {150, 0, 57}}}};
+  auto plan = ParseInspectionPlan(j, part);
+  ASSERT_TRUE(plan.ok()) << plan.status();
+  ASSERT_EQ(plan->holes.size(), 6u);
+  EXPECT_TRUE(plan->holes[5].slot) << "slots after holes";
+  EXPECT_EQ(plan->holes[5].name, "S1");
+  EXPECT_EQ(plan->holes[0].position_tolerance_mm, 0.25);
+  EXPECT_EQ(plan->edge_points[0].radius_mm, 5.0) << "the default";
+  const std::vector<std::pair<std::function<void(json&)>, std::string>> bad = {
+      {[](json& p) {
+         p["holes"][0]["position_mm"] = {0, 0, 60};
+       },
+       "plan.holes[0].position_mm: no hole of the CAD there (6 found: boundary loops that are "
+       "circles or slots)"},
+      {[](json& p) {
+         p["holes"][1]["axis"] = {0, 0, 0};
+       },
+       "plan.holes[1].axis: zero vector"},
+      {[](json& p) { p["holes"][0]["diameter_mm"] = -8; },
+       "plan.holes[0].diameter_mm: must be > 0"},
+      {[](json& p) { p["slots"][0]["length_mm"] = 5; },
+       "plan.slots[0].length_mm: must be > width_mm"},
+      {[](json& p) {
+         p["slots"][0]["direction"] = {0, 0, 1};
+       },
+       "plan.slots[0].direction: must be a finite vector across the axis"},
+      {[](json& p) { p["slots"][0].erase("direction"); }, "plan.slots[0].direction: missing"},
+      {[](json& p) { p["holes"][0]["depth_mm"] = 1; }, "plan.holes[0].depth_mm: unknown key"},
+      {[](json& p) { p["holes"][2]["name"] = "H1"; },
+       "plan.holes[2].name: duplicate name \"H1\" (characteristics share one namespace)"},
+      {[](json& p) {
+         p["edge_points"][0]["position_mm"] = {0, 0, 60};
+       },
+       "plan.edge_points[0].position_mm: the CAD's boundary is 20.8 mm away, farther than "
+       "radius_mm"},  // the edge of the 5 mm hole at (-20, -12)
+      {[](json& p) { p["edge_points"][0]["radius_mm"] = 0; },
+       "plan.edge_points[0].radius_mm: must be > 0"}};
+  for (const auto& [edit, message] : bad) {
+    json b = j;
+    edit(b);
+    EXPECT_EQ(ParseInspectionPlan(b, part).status().message(), message);
+  }
 }
 
 }  // namespace
