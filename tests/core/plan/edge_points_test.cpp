@@ -10,35 +10,10 @@
 #include "core/filter/link_clustering.h"
 #include "core/registration/registration.h"
 #include "core/simulation/demo_cell.h"
+#include "tests/support/demo_scans.h"
 
 namespace surfinspect {
 namespace {
-
-struct Scanned {
-  std::vector<ViewScan> views;
-  std::vector<PlanView> plan_views;
-};
-
-Scanned Scan(const DemoCell& cell, const PillarFeatures& made, uint64_t seed) {
-  DemoPart part;
-  part.number = int(seed);
-  part.manufactured = made;
-  ScanOptions opt;
-  opt.noise_sigma_mm = 0.015;
-  opt.seed = seed;
-  Scanned s;
-  for (std::size_t v = 0; v < cell.viewpoints.size(); ++v) {
-    auto scan = SimulateDemoPartScan(cell, part, v, opt);
-    EXPECT_TRUE(scan.ok()) << scan.status();
-    s.views.push_back(
-        {cell.viewpoints[v].name, scan->cloud_in_sensor, cell.viewpoints[v].world_from_sensor});
-  }
-  EXPECT_TRUE(FilterViews(s.views, LinkClusteringSettings::ForInspection()).ok());
-  for (const ViewScan& v : s.views)
-    s.plan_views.push_back(
-        {v.name, &v.cloud_in_sensor, cell.world_from_part.inverse() * v.world_from_sensor});
-  return s;
-}
 
 TEST(EdgePoints, ATrimmedEndIsFoundWithinAFifthOfAPixel) {
   const DemoCell cell = MakeDemoCell();
@@ -53,7 +28,7 @@ TEST(EdgePoints, ATrimmedEndIsFoundWithinAFifthOfAPixel) {
   for (double offset : {0.2, 0.5, 1.0}) {
     PillarFeatures made = cell.features;
     made.trim_offset_mm = offset;
-    const Scanned s = Scan(cell, made, 30 + uint64_t(offset * 10));
+    const testing::ScannedPart s = testing::ScanMadePart(cell, made, 30 + uint64_t(offset * 10));
     auto m = MeasureEdgePoints({end, flange}, cell.part, s.plan_views);
     ASSERT_TRUE(m.ok()) << m.status();
     for (int k = 0; k < 2; ++k) {

@@ -15,6 +15,7 @@
 #include "core/plan/profile_fit.h"
 #include "core/registration/registration.h"
 #include "core/simulation/demo_cell.h"
+#include "tests/support/demo_scans.h"
 
 namespace surfinspect {
 namespace {
@@ -32,35 +33,6 @@ PlanHole PlanHoleOf(const CadHole& c) {
   h.length_mm = c.length_mm;
   h.direction = c.direction;
   return h;
-}
-
-struct Scanned {
-  std::vector<ViewScan> views;
-  std::vector<PlanView> plan_views;
-};
-
-// The part made with `made`, scanned from the demo viewpoints `which` with
-// the demo's noise and filtered as inspect does.
-Scanned Scan(const DemoCell& cell, const PillarFeatures& made, const std::vector<int>& which,
-             uint64_t seed) {
-  DemoPart part;
-  part.number = int(seed);
-  part.manufactured = made;
-  ScanOptions opt;
-  opt.noise_sigma_mm = 0.015;
-  opt.seed = seed;
-  Scanned s;
-  for (int v : which) {
-    auto scan = SimulateDemoPartScan(cell, part, v, opt);
-    EXPECT_TRUE(scan.ok()) << scan.status();
-    s.views.push_back(
-        {cell.viewpoints[v].name, scan->cloud_in_sensor, cell.viewpoints[v].world_from_sensor});
-  }
-  EXPECT_TRUE(FilterViews(s.views, LinkClusteringSettings::ForInspection()).ok());
-  for (const ViewScan& v : s.views)
-    s.plan_views.push_back(
-        {v.name, &v.cloud_in_sensor, cell.world_from_part.inverse() * v.world_from_sensor});
-  return s;
 }
 
 std::vector<PlanHole> PlanHolesOf(const TriangleMesh& part) {
@@ -101,7 +73,7 @@ TEST(Holes, ShiftedAndResizedHolesAreMeasuredWithinAFifthOfAPixel) {
       h.diameter_mm += dd;
       if (h.length_mm > 0) h.length_mm += dd;
     }
-    const Scanned s = Scan(cell, made, {0, 1, 2, 3, 4}, seed);
+    const testing::ScannedPart s = testing::ScanMadePart(cell, made, seed);
     auto m = MeasureHoles(plan, s.plan_views);
     ASSERT_TRUE(m.ok()) << m.status();
     for (std::size_t k = 0; k < plan.size(); ++k) {
@@ -138,7 +110,7 @@ TEST(Holes, NoFalseVerdictOverTwentyPartsMadeAsDrawn) {
   for (uint64_t seed = 100; seed < 120; ++seed) {
     PillarFeatures made = cell.features;
     made.wall_depth_mm = 1.5;
-    const Scanned s = Scan(cell, made, {0, 1, 2, 3, 4}, seed);
+    const testing::ScannedPart s = testing::ScanMadePart(cell, made, seed);
     auto m = MeasureHoles(plan, s.plan_views);
     ASSERT_TRUE(m.ok()) << m.status();
     for (std::size_t k = 0; k < plan.size(); ++k) {
@@ -157,7 +129,8 @@ TEST(Holes, NoFalseVerdictOverTwentyPartsMadeAsDrawn) {
 TEST(Holes, AHoleNoViewSeesIsNotMeasured) {
   const DemoCell cell = MakeDemoCell();
   const std::vector<CadHole> cad = ListHoles(cell.part);
-  const Scanned s = Scan(cell, cell.features, {0}, 12);  // v1 looks at x = -120
+  const testing::ScannedPart s =
+      testing::ScanMadePart(cell, cell.features, 12, {0});  // v1 looks at x = -120
   std::vector<PlanHole> plan;
   for (const CadHole& c : cad)
     if (c.position_mm.x() > 60) plan.push_back(PlanHoleOf(c));
