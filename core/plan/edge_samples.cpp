@@ -13,7 +13,7 @@ constexpr int kPlaneRounds = 5;
 constexpr double kFaceSigmas = 4.0;      // a point within 4 sigma of the face is on it
 constexpr double kMinFaceBandMm = 0.03;  // ... or within 30 um (an ideal, noiseless face)
 
-// The local face h = c0 + c1 u + c2 v in the hole's frame (h along its axis).
+// The local face h = c0 + c1 u + c2 v in the contour's frame (h along its axis).
 struct Face {
   Eigen::Vector3d c = Eigen::Vector3d::Zero();
   double band_mm = 0;  // |h - face| within this is on the face
@@ -100,7 +100,7 @@ bool FitFace(const std::vector<const Pixel*>& pts, double max_h, Face* face) {
   return true;
 }
 
-// Where the ray of pixel (col, row) meets the face, in the hole's plane.
+// Where the ray of pixel (col, row) meets the face, in the contour's plane.
 bool MeetFace(const RayView& v, const PlaneFrame& f, const Face& face, int col, int row,
               Eigen::Vector2d* q) {
   const Eigen::Isometry3d& pfs = v.view->part_from_sensor;
