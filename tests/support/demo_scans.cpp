@@ -2,12 +2,11 @@
 
 #include <gtest/gtest.h>
 
-#include "core/filter/link_clustering.h"
-
 namespace surfinspect::testing {
 
 ScannedPart ScanMadePart(const DemoCell& cell, const PillarFeatures& made, uint64_t seed,
-                         const std::vector<std::size_t>& which) {
+                         const std::vector<std::size_t>& which,
+                         const LinkClusteringSettings& filter) {
   DemoPart part;
   part.number = int(seed);
   part.manufactured = made;
@@ -25,7 +24,7 @@ ScannedPart ScanMadePart(const DemoCell& cell, const PillarFeatures& made, uint6
     s.views.push_back(
         {cell.viewpoints[v].name, scan->cloud_in_sensor, cell.viewpoints[v].world_from_sensor});
   }
-  EXPECT_TRUE(FilterViews(s.views, LinkClusteringSettings::ForInspection()).ok());
+  EXPECT_TRUE(FilterViews(s.views, filter).ok());
   for (const ViewScan& v : s.views)
     s.plan_views.push_back(
         {v.name, &v.cloud_in_sensor, cell.world_from_part.inverse() * v.world_from_sensor});

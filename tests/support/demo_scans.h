@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/filter/link_clustering.h"
 #include "core/plan/edge_samples.h"
 #include "core/registration/registration.h"
 #include "core/simulation/demo_cell.h"
@@ -18,8 +19,11 @@ struct ScannedPart {
   std::vector<PlanView> plan_views;  // point into `views`: keep the struct in place
 };
 
-// `which`: indices into cell.viewpoints; empty: all of them.
-ScannedPart ScanMadePart(const DemoCell& cell, const PillarFeatures& made, uint64_t seed,
-                         const std::vector<std::size_t>& which = {});
+// `which`: indices into cell.viewpoints; empty: all of them. `filter`:
+// the inspection preset unless given (a coarser sensor needs a longer link).
+ScannedPart ScanMadePart(
+    const DemoCell& cell, const PillarFeatures& made, uint64_t seed,
+    const std::vector<std::size_t>& which = {},
+    const LinkClusteringSettings& filter = LinkClusteringSettings::ForInspection());
 
 }  // namespace surfinspect::testing

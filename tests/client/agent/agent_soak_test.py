@@ -103,6 +103,21 @@ def shrink_sensor(cell_json, width, height):
     cell["filter"] = {"link_distance_mm": DEMO_LINK_MM * scale}
     with open(cell_json, "w") as f:
         json.dump(cell, f, indent=2)
+    drop_edge_features(os.path.join(os.path.dirname(cell_json), cell.get("plan", "plan.json")))
+
+
+def drop_edge_features(plan_json):
+    """At a small sensor's pitch (1.5-2 mm) the demo's 5-12 mm holes are a few
+    pixels across, which surfinspect does not measure (core/plan/holes.cpp):
+    such a cell's plan judges the surface without holes and edge points."""
+    if not os.path.exists(plan_json):
+        return
+    with open(plan_json) as f:
+        plan = json.load(f)
+    for key in ("holes", "slots", "edge_points"):
+        plan.pop(key, None)
+    with open(plan_json, "w") as f:
+        json.dump(plan, f, indent=2)
 
 
 def make_cell(root):

@@ -147,5 +147,25 @@ TEST(Holes, AHoleNoViewSeesIsNotMeasured) {
   EXPECT_NE((*none)[0].reason.find("organized views"), std::string::npos) << (*none)[0].reason;
 }
 
+// On a coarse sensor (128 x 96: a 2 mm pitch on the part) the 5-12 mm holes
+// are a few pixels across: not measured, saying so, instead of a number.
+TEST(Holes, AHoleAFewPixelsAcrossIsNotMeasured) {
+  DemoCell cell = MakeDemoCell();
+  cell.intrinsics.width = 128;
+  cell.intrinsics.height = 96;
+  LinkClusteringSettings filter;  // the link scaled with the pitch, as the drift test's cell
+  filter.link_distance_mm = 4.0;
+  filter.min_cluster_points = 20;
+  const testing::ScannedPart s = testing::ScanMadePart(cell, cell.features, 21, {}, filter);
+  auto m = MeasureHoles(PlanHolesOf(cell.part), s.plan_views);
+  ASSERT_TRUE(m.ok()) << m.status();
+  std::size_t coarse = 0;
+  for (const HoleMeasurement& r : *m) {
+    EXPECT_FALSE(r.measured) << r.diameter_mm;
+    coarse += r.reason.find("pixels at a") != std::string::npos;
+  }
+  EXPECT_GT(coarse, 0u) << "at least one hole was seen, and refused for its size in pixels";
+}
+
 }  // namespace
 }  // namespace surfinspect
