@@ -11,6 +11,25 @@ execute_process(COMMAND ${CLI} info ${WORK}/tri.off RESULT_VARIABLE rc OUTPUT_VA
 if(NOT rc EQUAL 0 OR NOT out MATCHES "triangles: 2" OR NOT out MATCHES "closed: no")
   message(FATAL_ERROR "info on a mesh failed: ${rc}\n${out}")
 endif()
+# holes: a mesh without any lists none; the demo part lists its five holes
+# and its slot, and --plan prints them as plan entries.
+execute_process(COMMAND ${CLI} holes ${WORK}/tri.off RESULT_VARIABLE rc OUTPUT_VARIABLE out)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "^0 holes and slots")
+  message(FATAL_ERROR "holes on a plain mesh failed: ${rc}\n${out}")
+endif()
+execute_process(COMMAND ${CLI} demo-cell --out ${WORK}/demo --parts 0 RESULT_VARIABLE rc
+                OUTPUT_QUIET ERROR_QUIET)
+execute_process(COMMAND ${CLI} holes ${WORK}/demo/part.stl RESULT_VARIABLE rc OUTPUT_VARIABLE out)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "^6 holes and slots"
+   OR NOT out MATCHES "\nslot +95.000 +-8.000")
+  message(FATAL_ERROR "holes on the demo part failed: ${rc}\n${out}")
+endif()
+execute_process(COMMAND ${CLI} holes ${WORK}/demo/part.stl --plan --position-tolerance 0.25
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "\"name\": \"S1\"" OR NOT out MATCHES "\"name\": \"H5\""
+   OR NOT out MATCHES "\"position_tolerance_mm\": 0.25")
+  message(FATAL_ERROR "holes --plan failed: ${rc}\n${out}")
+endif()
 file(WRITE ${WORK}/c.pcd "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 2\nHEIGHT 2\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 4\nDATA ascii\n1 2 3\nnan nan nan\n4 5 6\n7 8 9\n")
 execute_process(COMMAND ${CLI} info ${WORK}/c.pcd RESULT_VARIABLE rc OUTPUT_VARIABLE out)
 if(NOT rc EQUAL 0 OR NOT out MATCHES "valid: 3" OR NOT out MATCHES "organized: yes \\(2 x 2\\)"
