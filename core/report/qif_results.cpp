@@ -77,8 +77,9 @@ std::string CharacteristicStatus(const std::string& verdict) {
 }
 
 // A surface, region or section is a surface profile of its points (a
-// section's slab too: QIF's LineProfile needs the plane's normal, which the
-// report does not carry); a comparison point is a point profile.
+// section's slab too: a LineProfile with the section's plane, which
+// report.json's "sections" now carries, is not written yet); a comparison
+// point and a trim-edge point are point profiles.
 absl::Status AddProfile(const ReportCharacteristic& c, const std::string& where,
                         std::vector<QifCharacteristic>& out) {
   QifCharacteristic q;
