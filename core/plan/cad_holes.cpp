@@ -14,20 +14,14 @@ namespace {
 // Boundary edges directed as their one triangle walks them, chained into
 // closed loops of vertex ids (a loop that does not close is dropped).
 std::vector<std::vector<uint32_t>> BoundaryLoops(const TriangleMesh& mesh) {
-  const std::vector<EdgeUse> uses = SortedEdgeUses(mesh);
   std::multimap<uint32_t, uint32_t> next;  // from -> to
-  for (std::size_t i = 0; i < uses.size();) {
-    std::size_t j = i + 1;
-    while (j < uses.size() && uses[j].edge == uses[i].edge) ++j;
-    if (j == i + 1) {
-      const Triangle& t = mesh.triangles[uses[i].triangle];
-      const auto lo = static_cast<uint32_t>(uses[i].edge >> 32);
-      const auto hi = static_cast<uint32_t>(uses[i].edge);
-      for (int k = 0; k < 3; ++k)
-        if ((t[k] == lo && t[(k + 1) % 3] == hi) || (t[k] == hi && t[(k + 1) % 3] == lo))
-          next.emplace(t[k], t[(k + 1) % 3]);
-    }
-    i = j;
+  for (const EdgeUse& use : BoundaryEdges(mesh)) {
+    const Triangle& t = mesh.triangles[use.triangle];
+    const auto lo = static_cast<uint32_t>(use.edge >> 32);
+    const auto hi = static_cast<uint32_t>(use.edge);
+    for (int k = 0; k < 3; ++k)
+      if ((t[k] == lo && t[(k + 1) % 3] == hi) || (t[k] == hi && t[(k + 1) % 3] == lo))
+        next.emplace(t[k], t[(k + 1) % 3]);
   }
   std::vector<std::vector<uint32_t>> loops;
   while (!next.empty()) {
@@ -151,16 +145,22 @@ std::vector<CadHole> ListHoles(const TriangleMesh& mesh, const CadHoleSettings& 
   return holes;
 }
 
-std::optional<CadEdge> NearestBoundaryEdge(const TriangleMesh& mesh, const Eigen::Vector3d& p) {
+std::vector<EdgeUse> BoundaryEdges(const TriangleMesh& mesh) {
   const std::vector<EdgeUse> uses = SortedEdgeUses(mesh);
+  std::vector<EdgeUse> out;
+  for (std::size_t i = 0; i < uses.size(); ++i)
+    if ((i == 0 || uses[i - 1].edge != uses[i].edge) &&
+        (i + 1 == uses.size() || uses[i + 1].edge != uses[i].edge))
+      out.push_back(uses[i]);
+  return out;
+}
+
+std::optional<CadEdge> NearestBoundaryEdge(const TriangleMesh& mesh, const Eigen::Vector3d& p) {
   std::optional<CadEdge> best;
-  for (std::size_t i = 0; i < uses.size(); ++i) {
-    if ((i > 0 && uses[i - 1].edge == uses[i].edge) ||
-        (i + 1 < uses.size() && uses[i + 1].edge == uses[i].edge))
-      continue;
-    const Triangle& t = mesh.triangles[uses[i].triangle];
-    const auto lo = static_cast<uint32_t>(uses[i].edge >> 32);
-    const auto hi = static_cast<uint32_t>(uses[i].edge);
+  for (const EdgeUse& use : BoundaryEdges(mesh)) {
+    const Triangle& t = mesh.triangles[use.triangle];
+    const auto lo = static_cast<uint32_t>(use.edge >> 32);
+    const auto hi = static_cast<uint32_t>(use.edge);
     const Eigen::Vector3d a = mesh.vertices[lo].cast<double>(),
                           b = mesh.vertices[hi].cast<double>();
     const double len2 = (b - a).squaredNorm();

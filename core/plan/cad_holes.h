@@ -52,6 +52,10 @@ struct CadHoleSettings {
   double max_flatness_ratio = 0.05;  // flatness / size at most this
 };
 
+// The mesh's boundary: its edges used by one triangle (SortedEdgeUses's
+// runs of one), with that triangle.
+std::vector<EdgeUse> BoundaryEdges(const TriangleMesh& mesh);
+
 // Sorted by position (x, then y, then z) so the list reads the same for the
 // same mesh.
 std::vector<CadHole> ListHoles(const TriangleMesh& mesh, const CadHoleSettings& settings = {});

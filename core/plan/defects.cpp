@@ -119,7 +119,7 @@ PatchEvidence MeasuredExtremes(const ErrorMapResult& em, const std::vector<float
     e.max_mm = std::max<double>(e.max_mm, em.deviation_mm[i]);
     residual.push_back(std::abs(em.deviation_mm[i] - median[i]));
   }
-  e.noise_mm = 1.4826 * MedianInPlace(residual);
+  e.noise_mm = MadSigma(residual);
   return e;
 }
 
@@ -159,6 +159,8 @@ GaussianFit RobustGaussianFit(const std::vector<Eigen::Vector3d>& uvd, const Gau
     abs_res[k] = std::abs(fit.baseline + fit.amplitude * std::exp(-r2 / (2 * s2)) - uvd[k].z());
   }
   std::vector<double> copy = abs_res;
+  // 5 robust sigmas (MadSigma), multiplied in this order so that the cut
+  // stays bit for bit what it was.
   const double cut = 5 * 1.4826 * MedianInPlace(copy);
   for (std::size_t k = 0; k < uvd.size(); ++k) keep[k] = abs_res[k] <= cut;
   return FitIsotropicGaussian(uvd, keep, fit);

@@ -41,7 +41,7 @@ EdgePointMeasurement Judge(const EdgeContour& c, const EdgeSamples& s, double ra
   const double median = MedianInPlace(copy);
   std::vector<double> abs_dev;
   for (double d : off) abs_dev.push_back(std::abs(d - median));
-  const double limit = std::max(kRejectSigmas * 1.4826 * MedianInPlace(abs_dev), 1e-3);
+  const double limit = std::max(kRejectSigmas * MadSigma(abs_dev), 1e-3);
   double sum = 0;
   for (double d : off)
     if (std::abs(d - median) <= limit) sum += d, ++m.points;

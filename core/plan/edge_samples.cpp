@@ -89,7 +89,7 @@ bool FitFace(const std::vector<const Pixel*>& pts, double max_h, Face* face) {
     face->c = lu.solve(atb);
     std::vector<double> abs_res;
     for (const Pixel* p : use) abs_res.push_back(std::abs(p->h - face->At(p->q)));
-    const double sigma = 1.4826 * MedianInPlace(abs_res);
+    const double sigma = MadSigma(abs_res);
     face->band_mm = std::max(kFaceSigmas * sigma, kMinFaceBandMm);
     std::vector<const Pixel*> kept;
     for (const Pixel* p : use)

@@ -20,11 +20,7 @@ constexpr std::size_t kMinSamples = 12;
 constexpr double kMinPixelsAcross = 8;
 
 ProfileFit NominalProfile(const PlanHole& h) {
-  ProfileFit p;
-  p.slot = h.slot;
-  p.radius = 0.5 * h.diameter_mm;
-  p.half_length = h.slot ? 0.5 * (h.length_mm - h.diameter_mm) : 0;
-  return p;  // centre 0, direction e1: the hole's frame
+  return NominalContour(h.slot, h.diameter_mm, h.length_mm);  // in the hole's frame
 }
 
 // The arc of the edge the kept samples cover, seen from the fitted centre:

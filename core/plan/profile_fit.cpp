@@ -117,7 +117,7 @@ bool RobustFit(const std::vector<Eigen::Vector2d>& pts, const ResidualFn& residu
     for (std::size_t i = 0; i < pts.size(); ++i) res[i] = residual(x, pts[i], nullptr);
     for (std::size_t i = 0; i < pts.size(); ++i)
       if (inlier[i]) abs_dev.push_back(std::abs(res[i]));
-    const double sigma = 1.4826 * MedianInPlace(abs_dev);
+    const double sigma = MadSigma(abs_dev);
     // A floor of 1 um: an exact contour (a CAD polygon) rejects nothing.
     const double limit = std::max(kRejectSigmas * sigma, 1e-3);
     std::vector<uint8_t> next(pts.size());
@@ -167,6 +167,14 @@ bool AlgebraicCircle(const std::vector<Eigen::Vector2d>& pts, Params& x) {
 }
 
 }  // namespace
+
+ProfileFit NominalContour(bool slot, double diameter, double length) {
+  ProfileFit p;
+  p.slot = slot;
+  p.radius = 0.5 * diameter;
+  p.half_length = slot ? 0.5 * (length - diameter) : 0;
+  return p;
+}
 
 double ProfileDistance(const ProfileFit& fit, const Eigen::Vector2d& q) {
   Params x(5);

@@ -37,6 +37,10 @@ struct ProfileFit {
   double length() const { return 2 * (half_length + radius); }  // a slot's overall length
 };
 
+// A nominal contour centred at the origin along +x: a circle of `diameter`,
+// or a slot of that width and overall `length` (slot only).
+ProfileFit NominalContour(bool slot, double diameter, double length);
+
 // Signed distance from q to the contour of `fit` (+ outside the hole).
 double ProfileDistance(const ProfileFit& fit, const Eigen::Vector2d& q);
 

@@ -66,4 +66,9 @@ double EstimateSurfaceSpacing(const ErrorMapResult& error_map, const PointCloud&
 // is empty.
 double MedianInPlace(std::vector<double>& v);
 
+// The robust sigma of residuals from their absolute values: 1.4826 times
+// their median (the MAD, scaled to a normal's standard deviation; Rousseeuw
+// and Croux, JASA 88 (1993)). Reorders `abs_residuals`; NaN when empty.
+double MadSigma(std::vector<double>& abs_residuals);
+
 }  // namespace surfinspect

@@ -9,25 +9,12 @@
 namespace surfinspect {
 namespace {
 
-// The hole's contour in its own frame, as ProfileDistance reads it.
-ProfileFit ContourOf(const CadHole& h) {
-  ProfileFit p;
-  p.slot = h.slot;
-  p.radius = 0.5 * h.diameter_mm;
-  p.half_length = h.slot ? 0.5 * h.length_mm - p.radius : 0;
-  return p;
-}
-
 // Vertices on boundary edges: the only ones an edge can be made of.
 std::vector<uint8_t> BoundaryVertices(const TriangleMesh& mesh) {
   std::vector<uint8_t> on(mesh.vertices.size(), 0);
-  const std::vector<EdgeUse> uses = SortedEdgeUses(mesh);
-  for (std::size_t i = 0; i < uses.size(); ++i) {
-    const bool alone = (i == 0 || uses[i - 1].edge != uses[i].edge) &&
-                       (i + 1 == uses.size() || uses[i + 1].edge != uses[i].edge);
-    if (!alone) continue;
-    on[uses[i].edge >> 32] = 1;
-    on[uses[i].edge & 0xffffffffu] = 1;
+  for (const EdgeUse& use : BoundaryEdges(mesh)) {
+    on[use.edge >> 32] = 1;
+    on[use.edge & 0xffffffffu] = 1;
   }
   return on;
 }
@@ -45,7 +32,7 @@ absl::StatusOr<TriangleMesh> ChangeHoles(const TriangleMesh& cad,
           absl::StrCat("hole ", c.hole, ": the CAD has ", holes.size(), " holes"));
     const CadHole& h = holes[c.hole];
     const PlaneFrame f = MakePlaneFrame(h.position_mm, h.axis, h.direction);
-    const ProfileFit contour = ContourOf(h);
+    const ProfileFit contour = NominalContour(h.slot, h.diameter_mm, h.length_mm);
     const Eigen::Vector3d shift = c.shift_mm - c.shift_mm.dot(f.axis) * f.axis;
     const double tol = std::max(0.01, 0.02 * contour.radius);
     for (std::size_t v = 0; v < cad.vertices.size(); ++v) {
