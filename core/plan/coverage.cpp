@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "absl/strings/str_cat.h"
 #include "core/types/cancel.h"
 
 namespace surfinspect {
@@ -14,41 +15,40 @@ namespace {
 
 constexpr std::size_t kMaxCells = std::size_t{1} << 22;  // per triangle; coarser beyond
 
-// Compressed rows: row r is items[offsets[r] .. offsets[r + 1]).
-template <typename T>
-struct Rows {
+// A triangle across an edge: its index and which of its edges (k: corner k
+// to corner k + 1) is the shared one.
+struct Neighbour {
+  uint32_t triangle;
+  uint8_t edge;
+};
+// Triangle t's neighbours: items[offsets[t] .. offsets[t + 1]).
+struct Neighbours {
   std::vector<uint32_t> offsets;
-  std::vector<T> items;
+  std::vector<Neighbour> items;
 };
 
-// The matched closest points by their CAD triangle (a counting sort).
-Rows<Eigen::Vector3f> PointsByTriangle(const ErrorMapResult& em, std::size_t triangles) {
-  Rows<Eigen::Vector3f> r;
-  r.offsets.assign(triangles + 1, 0);
-  for (uint32_t t : em.triangle_id)
-    if (t < triangles) ++r.offsets[t + 1];
-  for (std::size_t t = 0; t < triangles; ++t) r.offsets[t + 1] += r.offsets[t];
-  std::vector<uint32_t> next(r.offsets.begin(), r.offsets.end() - 1);
-  r.items.resize(r.offsets.back());
-  for (std::size_t i = 0; i < em.triangle_id.size(); ++i)
-    if (em.triangle_id[i] < triangles) r.items[next[em.triangle_id[i]]++] = em.closest_point[i];
-  return r;
+uint8_t EdgeIndex(const TriangleMesh& part, uint32_t t, uint64_t key) {
+  const auto& v = part.triangles[t];  // the key is SortedEdgeUses': low id << 32 | high id
+  for (uint8_t k = 0; k < 2; ++k)
+    if (key == (uint64_t{std::min(v[k], v[k + 1])} << 32 | std::max(v[k], v[k + 1]))) return k;
+  return 2;
 }
 
 // The triangles sharing an edge with each triangle.
-Rows<uint32_t> EdgeNeighbours(const TriangleMesh& part) {
+Neighbours EdgeNeighbours(const TriangleMesh& part) {
   const std::vector<EdgeUse> edges = SortedEdgeUses(part);
-  std::vector<std::vector<uint32_t>> lists(part.num_triangles());
+  std::vector<std::vector<Neighbour>> lists(part.num_triangles());
   for (std::size_t i = 0; i < edges.size();) {
     std::size_t j = i;
     while (j < edges.size() && edges[j].edge == edges[i].edge) ++j;
     for (std::size_t p = i; p < j; ++p)
       for (std::size_t q = i; q < j; ++q)
         if (edges[p].triangle != edges[q].triangle)
-          lists[edges[p].triangle].push_back(edges[q].triangle);
+          lists[edges[p].triangle].push_back(
+              {edges[q].triangle, EdgeIndex(part, edges[q].triangle, edges[q].edge)});
     i = j;
   }
-  Rows<uint32_t> r;
+  Neighbours r;
   r.offsets.push_back(0);
   for (const auto& l : lists) {
     r.items.insert(r.items.end(), l.begin(), l.end());
@@ -57,163 +57,210 @@ Rows<uint32_t> EdgeNeighbours(const TriangleMesh& part) {
   return r;
 }
 
+// A triangle's plane: corner 0 at the origin, u along edge 0, the corners
+// counter-clockwise. Degenerate (zero or non-finite area): !ok.
+struct TriangleFrame {
+  TriangleFrame(const TriangleMesh& part, uint32_t t) {
+    const auto& tri = part.triangles[t];
+    o = part.vertices[tri[0]].cast<double>();
+    const Eigen::Vector3d b = part.vertices[tri[1]].cast<double>() - o,
+                          c = part.vertices[tri[2]].cast<double>() - o;
+    area = 0.5 * b.cross(c).norm();
+    ok = area > 0 && std::isfinite(area);
+    if (!ok) return;
+    u = b.normalized();
+    v = b.cross(c).cross(b).normalized();
+    corner[0] = Eigen::Vector2d::Zero();
+    corner[1] = {b.norm(), 0};
+    corner[2] = {c.dot(u), c.dot(v)};
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector2d e = (corner[(k + 1) % 3] - corner[k]).normalized();
+      outward[k] = {e.y(), -e.x()};
+    }
+    of = o.cast<float>();
+    uf = u.cast<float>();
+    vf = v.cast<float>();
+  }
+  // In float: relative to a corner, millimetres keep ~1e-5 mm here.
+  Eigen::Vector2d Project(const Eigen::Vector3f& q) const {
+    const Eigen::Vector3f d = q - of;
+    return {d.dot(uf), d.dot(vf)};
+  }
+  // Signed distance of p outside edge k's line (negative inside).
+  double Outside(const Eigen::Vector2d& p, int k) const { return outward[k].dot(p - corner[k]); }
+  Eigen::Vector3d At(const Eigen::Vector2d& p) const { return o + p.x() * u + p.y() * v; }
+
+  bool ok = false;
+  double area = 0;
+  Eigen::Vector3d o = Eigen::Vector3d::Zero(), u = Eigen::Vector3d::UnitX(),
+                  v = Eigen::Vector3d::UnitY();
+  Eigen::Vector2d corner[3], outward[3];  // outward: unit edge normals in the plane
+  Eigen::Vector3f of, uf, vf;             // o, u, v in float, for the points
+};
+
+// Per point of `points` (same order): bit k set when the point lies within
+// `reach` of its triangle's edge k line, in the triangle's plane. Only such
+// points can cover the neighbour across edge k: on a flat or gently bent
+// surface the neighbour lies beyond that line; across a sharp fold a point
+// deep in its face no longer reaches the other face's edge by projection.
+std::vector<uint8_t> NearEdges(const TriangleMesh& part, const ErrorMapResult& em,
+                               const TrianglePoints& points, double reach) {
+  std::vector<uint8_t> mask(points.points.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<uint32_t>(0, part.num_triangles(), 64), [&](auto range) {
+    for (uint32_t t = range.begin(); t != range.end(); ++t) {
+      const TriangleFrame f(part, t);
+      if (!f.ok) continue;
+      for (uint32_t i = points.begin(t); i < points.end(t); ++i) {
+        const Eigen::Vector2d p = f.Project(em.closest_point[points.points[i]]);
+        for (int k = 0; k < 3; ++k) mask[i] |= (f.Outside(p, k) >= -reach) << k;
+      }
+    }
+  });
+  return mask;
+}
+
 // One triangle's sampling: a square grid of cells in its plane, the cells
 // whose centres lie inside it standing for equal parts of its area. The
 // grid has a margin of `reach` around the triangle, where the points of its
-// neighbours land. A cell is covered when a point lies within reach of its
-// centre. Two passes over the points: the first marks the cells holding
-// one; the second covers exactly around the points whose cell is not
-// enclosed by four such cells. Inside an occupied area each cell covers
-// itself (its point is within half a diagonal of its centre), so the work
-// is at the edges of what was seen and where the sampling is sparse.
+// neighbours land. A sample is covered when a point lies within reach of
+// its centre: the points are listed per cell, and each sample looks at the
+// cells around it. A cell whose every point is within reach (the "sure"
+// stencil) decides by being occupied; a cell only partly within reach (the
+// "maybe" stencil) by its points' distances. Inside an occupied area the
+// first look decides, so the exact work is at the edges of what was seen.
 class TriangleRaster {
  public:
-  TriangleRaster(const TriangleMesh& part, uint32_t t, double cell_mm, double reach) {
-    const auto& tri = part.triangles[t];
-    o_ = part.vertices[tri[0]].cast<double>();
-    const Eigen::Vector3d b = part.vertices[tri[1]].cast<double>() - o_,
-                          c = part.vertices[tri[2]].cast<double>() - o_;
-    area_ = 0.5 * b.cross(c).norm();
-    if (!(area_ > 0) || !std::isfinite(area_)) {  // degenerate: one sample, never covered,
-      state_.assign(1, 0);                        // weighing nothing
+  TriangleRaster(const TriangleMesh& part, uint32_t t, double cell_mm, double reach)
+      : f_(part, t), reach_(reach) {
+    if (!f_.ok) {  // degenerate: one sample, never covered, weighing nothing
+      head_.assign(1, -1);
       cells_.push_back(0);
       return;
     }
-    u_ = b.normalized();
-    v_ = b.cross(c).cross(b).normalized();
-    corner_[0] = Eigen::Vector2d::Zero();
-    corner_[1] = {b.norm(), 0};
-    corner_[2] = {c.dot(u_), c.dot(v_)};
-    const Eigen::Vector2d lo = corner_[0].cwiseMin(corner_[1]).cwiseMin(corner_[2]);
-    const Eigen::Vector2d size = corner_[0].cwiseMax(corner_[1]).cwiseMax(corner_[2]) - lo;
+    const Eigen::Vector2d lo = f_.corner[0].cwiseMin(f_.corner[1]).cwiseMin(f_.corner[2]);
+    const Eigen::Vector2d size = f_.corner[0].cwiseMax(f_.corner[1]).cwiseMax(f_.corner[2]) - lo;
     h_ = std::max({cell_mm, std::sqrt(size.x() * size.y() / kMaxCells), 1e-6});
     reach_cells_ = static_cast<int>(std::ceil(reach / h_));
     lo_ = lo - Eigen::Vector2d::Constant(reach_cells_ * h_);
     nx_ = static_cast<int>(std::ceil(size.x() / h_)) + 2 * reach_cells_;
     ny_ = static_cast<int>(std::ceil(size.y() / h_)) + 2 * reach_cells_;
-    for (int iy = 0; iy < ny_; ++iy)
-      for (int ix = 0; ix < nx_; ++ix)
-        if (Inside(Centre(ix, iy))) cells_.push_back(Index(ix, iy));
+    ListSamples();
     if (cells_.empty()) {  // smaller than a cell: its centroid's cell stands for it
-      const Eigen::Vector2d g = (corner_[0] + corner_[1] + corner_[2]) / 3 - lo_;
+      const Eigen::Vector2d g = (f_.corner[0] + f_.corner[1] + f_.corner[2]) / 3 - lo_;
       cells_.push_back(Index(static_cast<int>(g.x() / h_), static_cast<int>(g.y() / h_)));
     }
-    state_.assign(static_cast<std::size_t>(nx_) * ny_, 0);
-    of_ = o_.cast<float>();
-    uf_ = u_.cast<float>();
-    vf_ = v_.cast<float>();
+    head_.assign(static_cast<std::size_t>(nx_) * ny_, -1);
     inv_h_ = 1 / h_;
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector2d e = (corner_[(k + 1) % 3] - corner_[k]).normalized();
-      outward_[k] = {e.y(), -e.x()};
-    }
-    const Eigen::Vector3d g = o_ + (b + c) / 3;
+    const Eigen::Vector3d g = f_.At((f_.corner[1] + f_.corner[2]) / 3);
     centre_ = g.cast<float>();
-    const double r = std::max({(o_ - g).norm(), (o_ + b - g).norm(), (o_ + c - g).norm()}) +
-                     (reach_cells_ + 2) * h_;
+    double r = 0;
+    for (const auto& c : f_.corner) r = std::max(r, (f_.At(c) - g).norm());
+    r += (reach_cells_ + 2) * h_;
     bound2_ = static_cast<float>(r * r);
+    MakeStencils();
   }
 
-  // A point projected on the plane, and its cell.
-  struct Located {
-    Eigen::Vector2d p;
-    int cx, cy;
-  };
-  // False when q is off the grid or farther than `reach` from the triangle
-  // (first by the grid's bounding sphere, a cheap test).
-  bool Locate(const Eigen::Vector3f& q, double reach, Located& out) const {
-    if ((q - centre_).squaredNorm() > bound2_) return false;
-    // In float: relative to a corner, millimetres keep ~1e-5 mm here.
-    const Eigen::Vector3f d = q - of_;
-    out.p = Eigen::Vector2d(d.dot(uf_), d.dot(vf_));
-    if (Beyond(out.p, reach)) return false;
-    const double x = (out.p.x() - lo_.x()) * inv_h_, y = (out.p.y() - lo_.y()) * inv_h_;
-    if (!(x >= 0 && y >= 0 && x < nx_ && y < ny_)) return false;
-    out.cx = static_cast<int>(x);
-    out.cy = static_cast<int>(y);
-    return true;
-  }
-  void Occupy(const Located& l) { state_[Index(l.cx, l.cy)] = kOccupied; }
-
-  // Covers the samples within reach of the point, unless its cell is
-  // enclosed by occupied cells (their points cover what it would); call
-  // after every point was occupied.
-  void Cover(const Located& l, double reach) {
-    if (Enclosed(l.cx, l.cy)) {
-      state_[Index(l.cx, l.cy)] |= kCovered;  // within h / sqrt(2) < reach of its centre
-      return;
-    }
-    // Row by row, the cells whose centres lie within reach: a span.
-    const int y1 = std::min(ny_ - 1, l.cy + reach_cells_);
-    for (int iy = std::max(0, l.cy - reach_cells_); iy <= y1; ++iy) {
-      const double dy = lo_.y() + h_ * (iy + 0.5) - l.p.y();
-      const double w2 = reach * reach - dy * dy;
-      if (w2 < 0) continue;
-      const double w = std::sqrt(w2), x = (l.p.x() - lo_.x()) / h_ - 0.5;
-      const int x0 = std::max(0, static_cast<int>(std::ceil(x - w / h_)));
-      const int x1 = std::min(nx_ - 1, static_cast<int>(std::floor(x + w / h_)));
-      uint8_t* row = &state_[static_cast<std::size_t>(iy) * nx_];
-      for (int ix = x0; ix <= x1; ++ix) row[ix] |= kCovered;
-    }
+  // Adds q when it lies on the grid within reach of the triangle (first
+  // tested by the grid's bounding sphere, a cheap test). `own`: q is a
+  // closest point on this triangle, so on the grid.
+  void Add(const Eigen::Vector3f& q, bool own) {
+    if (!own && (q - centre_).squaredNorm() > bound2_) return;
+    const Eigen::Vector2d p = f_.Project(q);
+    if (!own)
+      for (int k = 0; k < 3; ++k)
+        if (f_.Outside(p, k) > reach_) return;
+    const double x = (p.x() - lo_.x()) * inv_h_, y = (p.y() - lo_.y()) * inv_h_;
+    if (!(x >= 0 && y >= 0 && x < nx_ && y < ny_)) return;
+    const std::size_t c = static_cast<std::size_t>(y) * nx_ + static_cast<std::size_t>(x);
+    next_.push_back(head_[c]);
+    points_.push_back(p);
+    head_[c] = static_cast<int32_t>(points_.size() - 1);
   }
 
-  // Calls f(3D location, covered) for each sample; returns their count.
+  // Calls f(3D location, covered) for each sample, after every point was
+  // added.
   template <typename F>
-  std::size_t ForEachSample(F&& f) const {
+  void ForEachSample(F&& f) const {
     for (std::size_t c : cells_)
-      f(At(Centre(static_cast<int>(c % nx_), static_cast<int>(c / nx_))), state_[c] & kCovered);
-    return cells_.size();
+      f(f_.At(Centre(static_cast<int>(c % nx_), static_cast<int>(c / nx_))), Covered(c));
   }
-  double area() const { return area_; }
+  std::size_t CountCovered() const {
+    std::size_t n = 0;
+    for (std::size_t c : cells_) n += Covered(c);
+    return n;
+  }
+  std::size_t samples() const { return cells_.size(); }
+  double area() const { return f_.area; }
 
  private:
-  static constexpr uint8_t kOccupied = 1, kCovered = 2;
-
+  // The cells whose centres lie inside: per row, those around the span the
+  // edges' lines allow, each tested (the span's rounding adds or drops none).
+  void ListSamples() {
+    const double left = lo_.x() - h_, right = lo_.x() + (nx_ + 1) * h_;
+    for (int iy = 0; iy < ny_; ++iy) {
+      const double y = lo_.y() + h_ * (iy + 0.5);
+      double x0 = left, x1 = right;
+      for (int k = 0; k < 3; ++k) {  // inside edge k: n.x (x - c.x) + n.y (y - c.y) <= 0
+        const Eigen::Vector2d &n = f_.outward[k], &c = f_.corner[k];
+        const double rest = n.y() * (y - c.y());
+        if (n.x() > 0) x1 = std::min(x1, c.x() - rest / n.x());
+        if (n.x() < 0) x0 = std::max(x0, c.x() - rest / n.x());
+        if (n.x() == 0 && rest > 0) x1 = left - h_;
+      }
+      if (!(x0 <= x1)) continue;
+      const int a = std::max(0, static_cast<int>(std::floor((x0 - lo_.x()) / h_ - 0.5)) - 1);
+      const int b = std::min(nx_ - 1, static_cast<int>(std::ceil((x1 - lo_.x()) / h_ - 0.5)) + 1);
+      for (int ix = a; ix <= b; ++ix)
+        if (Inside(Centre(ix, iy))) cells_.push_back(Index(ix, iy));
+    }
+  }
   std::size_t Index(int ix, int iy) const {
     return static_cast<std::size_t>(std::clamp(iy, 0, ny_ - 1)) * nx_ + std::clamp(ix, 0, nx_ - 1);
-  }
-  // All four edge neighbours occupied: its disc adds nothing they do not.
-  // Wrong only for a disc reaching past an unoccupied cell behind them, which
-  // an occupied neighbour within reach covers in turn.
-  bool Enclosed(int ix, int iy) const {
-    if (ix == 0 || iy == 0 || ix + 1 == nx_ || iy + 1 == ny_) return false;
-    const std::size_t i = static_cast<std::size_t>(iy) * nx_ + ix;
-    return state_[i - 1] & state_[i + 1] & state_[i - nx_] & state_[i + nx_] & kOccupied;
   }
   Eigen::Vector2d Centre(int ix, int iy) const {
     return lo_ + h_ * Eigen::Vector2d(ix + 0.5, iy + 0.5);
   }
-  Eigen::Vector2d Project(const Eigen::Vector3f& q) const {
-    const Eigen::Vector3d d = q.cast<double>() - o_;
-    return {d.dot(u_), d.dot(v_)};
-  }
-  Eigen::Vector3d At(const Eigen::Vector2d& p) const { return o_ + p.x() * u_ + p.y() * v_; }
-  // Farther than `reach` outside one of the edges' lines (a lower bound of
-  // the distance to the triangle); the corners are counter-clockwise.
-  bool Beyond(const Eigen::Vector2d& p, double reach) const {
+  bool Inside(const Eigen::Vector2d& p) const {
     for (int k = 0; k < 3; ++k)
-      if (outward_[k].dot(p - corner_[k]) > reach) return true;
-    return false;
-  }
-  bool Inside(const Eigen::Vector2d& p) const {  // the corners are counter-clockwise
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector2d e = corner_[(k + 1) % 3] - corner_[k], w = p - corner_[k];
-      if (e.x() * w.y() - e.y() * w.x() < 0) return false;
-    }
+      if (f_.Outside(p, k) > 0) return false;
     return true;
   }
+  // Cell offsets (as index steps) by the farthest and the nearest a point
+  // in that cell can be from a sample's centre. A sample lies at least
+  // reach_cells_ from the grid's border, so no step leaves the grid.
+  void MakeStencils() {
+    const double r = reach_ / h_;
+    for (int dy = -reach_cells_; dy <= reach_cells_; ++dy)
+      for (int dx = -reach_cells_; dx <= reach_cells_; ++dx) {
+        const double ax = std::abs(dx), ay = std::abs(dy);
+        const long step = static_cast<long>(dy) * nx_ + dx;
+        if (std::hypot(ax + 0.5, ay + 0.5) <= r)
+          sure_.push_back(step);
+        else if (std::hypot(std::max(ax - 0.5, 0.0), std::max(ay - 0.5, 0.0)) <= r)
+          maybe_.push_back(step);
+      }
+  }
+  bool Covered(std::size_t c) const {
+    if (!f_.ok) return false;
+    for (long s : sure_)
+      if (head_[c + s] >= 0) return true;
+    const Eigen::Vector2d centre = Centre(static_cast<int>(c % nx_), static_cast<int>(c / nx_));
+    for (long s : maybe_)
+      for (int32_t i = head_[c + s]; i >= 0; i = next_[i])
+        if ((points_[i] - centre).squaredNorm() <= reach_ * reach_) return true;
+    return false;
+  }
 
-  Eigen::Vector3d o_ = Eigen::Vector3d::Zero(), u_ = Eigen::Vector3d::UnitX(),
-                  v_ = Eigen::Vector3d::UnitY();
-  Eigen::Vector2d corner_[3], lo_ = Eigen::Vector2d::Zero(), outward_[3];  // unit edge normals
+  TriangleFrame f_;
+  double reach_, h_ = 1, inv_h_ = 1;
+  Eigen::Vector2d lo_ = Eigen::Vector2d::Zero();
   Eigen::Vector3f centre_ = Eigen::Vector3f::Zero();  // the bounding sphere of the grid's reach
-  Eigen::Vector3f of_, uf_, vf_;                      // o_, u_, v_ in float, for the points
-  double inv_h_ = 1;
   float bound2_ = -1;  // < 0: no point is near (a degenerate triangle)
-  double h_ = 1, area_ = 0;
   int nx_ = 1, ny_ = 1, reach_cells_ = 0;
-  std::vector<std::size_t> cells_;
-  std::vector<uint8_t> state_;
+  std::vector<std::size_t> cells_;  // the samples
+  std::vector<long> sure_, maybe_;
+  std::vector<int32_t> head_, next_;  // per cell its last point, per point the one before
+  std::vector<Eigen::Vector2d> points_;
 };
 
 // Per-triangle results: covered fraction, and per reachable comparison
@@ -224,32 +271,44 @@ struct TriangleSums {
   std::vector<double> point_area, point_covered;
 };
 
-// Triangle t sampled and covered by the points on it and on the triangles
-// sharing its edges (so coverage runs across an edge as on the surface).
+// What one triangle's sampling reads: the points by triangle, which of
+// them are near which edge, and the neighbours across the edges.
+struct CoverageInputs {
+  const std::vector<Eigen::Vector3f>& closest;  // the error map's
+  const TrianglePoints& points;
+  const std::vector<uint8_t>& near_edges;
+  const Neighbours& neighbours;
+};
+
+// Triangle t sampled and covered by the points on it and those on the
+// triangles across its edges near the shared edge (so coverage runs across
+// an edge as on the surface).
 void SampleTriangle(const TriangleMesh& part, const ResolvedInspectionPlan& rp,
-                    const Rows<Eigen::Vector3f>& points, const Rows<uint32_t>& neighbours,
-                    const CoverageSettings& s, uint32_t t, TriangleSums& out) {
+                    const CoverageInputs& in, const CoverageSettings& s, uint32_t t,
+                    TriangleSums& out) {
   // A comparison point's disc gets samples however small it is: its
   // triangles are sampled at a third of the smallest radius reaching them.
   double cell = s.sample_mm;
   for (uint32_t k = rp.point_offsets[t]; k < rp.point_offsets[t + 1]; ++k)
     cell = std::min(cell, rp.plan.points[rp.point_ids[k]].radius_mm / 3);
   TriangleRaster raster(part, t, cell, s.distance_mm);
-  std::vector<TriangleRaster::Located> located;
-  TriangleRaster::Located l;
-  const auto locate = [&](uint32_t tri) {
-    for (uint32_t k = points.offsets[tri]; k < points.offsets[tri + 1]; ++k)
-      if (raster.Locate(points.items[k], s.distance_mm, l)) located.push_back(l);
-  };
-  locate(t);
-  for (uint32_t k = neighbours.offsets[t]; k < neighbours.offsets[t + 1]; ++k)
-    locate(neighbours.items[k]);
-  for (const auto& p : located) raster.Occupy(p);
-  for (const auto& p : located) raster.Cover(p, s.distance_mm);
+  for (uint32_t i = in.points.begin(t); i < in.points.end(t); ++i)
+    raster.Add(in.closest[in.points.points[i]], true);
+  for (uint32_t k = in.neighbours.offsets[t]; k < in.neighbours.offsets[t + 1]; ++k) {
+    const Neighbour& n = in.neighbours.items[k];
+    for (uint32_t i = in.points.begin(n.triangle); i < in.points.end(n.triangle); ++i)
+      if (in.near_edges[i] >> n.edge & 1) raster.Add(in.closest[in.points.points[i]], false);
+  }
   const uint32_t first = rp.point_offsets[t], last = rp.point_offsets[t + 1];
+  const std::size_t samples = raster.samples();
+  if (first == last) {  // no comparison point: the count alone
+    out.covered[t] = static_cast<float>(static_cast<double>(raster.CountCovered()) /
+                                        static_cast<double>(samples));
+    return;
+  }
   std::size_t covered = 0;
   std::vector<std::pair<std::size_t, bool>> near;  // (row k, covered) per sample in a point's disc
-  const std::size_t samples = raster.ForEachSample([&](const Eigen::Vector3d& q, bool hit) {
+  raster.ForEachSample([&](const Eigen::Vector3d& q, bool hit) {
     covered += hit;
     for (uint32_t k = first; k < last; ++k) {
       const ComparisonPoint& p = rp.plan.points[rp.point_ids[k]];
@@ -271,26 +330,38 @@ double Fraction(double covered, double area) { return area > 0 ? covered / area 
 absl::StatusOr<CoverageResult> ComputeCoverage(const ErrorMapResult& em, const TriangleMesh& part,
                                                const ResolvedInspectionPlan& rp,
                                                const CoverageSettings& settings,
-                                               const std::atomic<bool>* cancel) {
+                                               const std::atomic<bool>* cancel,
+                                               const TrianglePoints* by_triangle) {
   CoverageSettings s = settings;
   if (!(s.distance_mm > 0) || !std::isfinite(s.distance_mm) || !(s.sample_mm >= 0))
     return absl::InvalidArgumentError("coverage: distance_mm must be > 0, sample_mm >= 0");
   if (s.sample_mm == 0) s.sample_mm = s.distance_mm / 2;
-  if (rp.num_triangles != part.num_triangles() || em.closest_point.size() != em.triangle_id.size())
+  if (rp.num_triangles != part.num_triangles() ||
+      em.closest_point.size() != em.triangle_id.size() ||
+      (by_triangle && by_triangle->offsets.size() != part.num_triangles() + 1))
     return absl::InvalidArgumentError("coverage: the plan, the part and the error map differ");
-  const Rows<Eigen::Vector3f> points = PointsByTriangle(em, part.num_triangles());
-  const Rows<uint32_t> neighbours = EdgeNeighbours(part);
   TriangleSums sums{std::vector<float>(part.num_triangles(), 0.f),
                     std::vector<double>(rp.point_ids.size(), 0),
                     std::vector<double>(rp.point_ids.size(), 0)};
   tbb::task_arena arena(s.threads > 0 ? s.threads : tbb::task_arena::automatic);
+  absl::Status status;
   arena.execute([&] {
+    absl::StatusOr<TrianglePoints> own;
+    if (!by_triangle) {
+      own = PointsByTriangle(em, part.num_triangles());
+      if (!own.ok()) return void(status = own.status());
+    }
+    const TrianglePoints& points = by_triangle ? *by_triangle : *own;
+    const std::vector<uint8_t> near_edges = NearEdges(part, em, points, s.distance_mm);
+    const Neighbours neighbours = EdgeNeighbours(part);
+    const CoverageInputs in{em.closest_point, points, near_edges, neighbours};
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, rp.num_triangles, 64), [&](auto range) {
       if (IsCancelled(cancel)) return;
       for (uint32_t t = range.begin(); t != range.end(); ++t)
-        SampleTriangle(part, rp, points, neighbours, s, t, sums);
+        SampleTriangle(part, rp, in, s, t, sums);
     });
   });
+  if (!status.ok()) return absl::InvalidArgumentError(absl::StrCat("coverage: ", status.message()));
   if (IsCancelled(cancel)) return absl::CancelledError("coverage cancelled");
   CoverageResult out;
   out.distance_mm = s.distance_mm;

@@ -8,9 +8,10 @@
 // triangle's plane; the cells whose centres lie inside the triangle stand
 // for equal parts of its area (a triangle smaller than a cell, by its
 // centroid). A sample is covered by the matched closest points on its
-// triangle and on the triangles sharing its edges, so coverage runs across
-// an edge as on the surface (not across a vertex-only neighbour: a
-// scanned area ending exactly at such a corner loses a sliver < distance_mm).
+// triangle and those on the triangles sharing its edges that lie within
+// distance_mm of the shared edge, so coverage runs across an edge as on the
+// surface (not across a vertex-only neighbour: a scanned area ending
+// exactly at such a corner loses a sliver < distance_mm).
 // Per triangle, region (ResolvedInspectionPlan's rows) and the whole
 // surface; a comparison point's coverage is that of the part of the surface
 // within its radius. Units mm, part frame. Deterministic for any thread count.
@@ -23,6 +24,7 @@
 #include "absl/status/statusor.h"
 #include "core/errormap/error_map.h"
 #include "core/plan/inspection_plan.h"
+#include "core/plan/triangle_points.h"
 #include "core/types/triangle_mesh.h"
 
 namespace surfinspect {
@@ -41,13 +43,15 @@ struct CoverageResult {
   std::vector<float> triangles;           // per CAD triangle, for the reports' pictures
 };
 
-// `error_map` was computed against `part`; `plan` was resolved on `part`.
-// InvalidArgument for bad settings or mismatched sizes; Cancelled when
-// `cancel` is raised (polled per block of triangles).
+// `error_map` was computed against `part`; `plan` was resolved on `part`;
+// `by_triangle`, when given, is PointsByTriangle of the same map and part
+// (built here otherwise). InvalidArgument for bad settings or mismatched
+// sizes; Cancelled when `cancel` is raised (polled per block of triangles).
 absl::StatusOr<CoverageResult> ComputeCoverage(const ErrorMapResult& error_map,
                                                const TriangleMesh& part,
                                                const ResolvedInspectionPlan& plan,
                                                const CoverageSettings& settings,
-                                               const std::atomic<bool>* cancel = nullptr);
+                                               const std::atomic<bool>* cancel = nullptr,
+                                               const TrianglePoints* by_triangle = nullptr);
 
 }  // namespace surfinspect

@@ -1,5 +1,10 @@
 #include "core/plan/plan_evaluation.h"
 
+#include <tbb/task_arena.h>
+
+#include <optional>
+#include <utility>
+
 #include "absl/strings/str_cat.h"
 #include "core/io/io_mesh.h"
 #include "core/plan/surface_neighbourhood.h"
@@ -49,7 +54,8 @@ namespace {
 // Each section of the plan cut on the map, limited to its region's triangles.
 absl::StatusOr<std::vector<SectionCut>> CutSections(const ErrorMapResult& em,
                                                     const TriangleMesh& part,
-                                                    const ResolvedInspectionPlan& rp) {
+                                                    const ResolvedInspectionPlan& rp,
+                                                    const TrianglePoints* by_triangle) {
   std::vector<SectionCut> out;
   for (const PlanSection& s : rp.plan.sections) {
     std::vector<uint8_t> mask;
@@ -60,7 +66,8 @@ absl::StatusOr<std::vector<SectionCut>> CutSections(const ErrorMapResult& em,
         for (uint32_t k = rp.region_offsets[t]; k < rp.region_offsets[t + 1]; ++k)
           mask[t] |= rp.region_ids[k] == r;
     }
-    ASSIGN_OR_RETURN(auto cut, CutSection(part, em, {s.point_mm, s.normal, s.width_mm}, mask));
+    ASSIGN_OR_RETURN(auto cut, CutSection(part, em, {s.point_mm, s.normal, s.width_mm}, mask,
+                                          kDefaultMaxWhiskers, by_triangle));
     out.push_back(std::move(cut));
   }
   return out;
@@ -85,12 +92,23 @@ absl::StatusOr<PlanOutcome> EvaluatePlan(const ErrorMapResult& error_map, const 
   // The sampling spacing, estimated once for coverage and defects alike.
   const bool coverage = PlanJudgesCoverage(plan);
   const double spacing = coverage || plan.defects ? EstimateSurfaceSpacing(error_map, cloud) : 0.0;
+  // The points by triangle, once for coverage and sections.
+  std::optional<TrianglePoints> by_triangle;
+  if (coverage || !plan.sections.empty()) {
+    tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
+    absl::StatusOr<TrianglePoints> grouped;
+    arena.execute([&] { grouped = PointsByTriangle(error_map, part.num_triangles()); });
+    if (!grouped.ok()) return grouped.status();
+    by_triangle = std::move(*grouped);
+  }
+  const TrianglePoints* grouped = by_triangle ? &*by_triangle : nullptr;
   if (coverage) {
     CoverageSettings cov;
     cov.distance_mm =
         plan.coverage_distance_mm > 0 ? plan.coverage_distance_mm : kCoverageSpacings * spacing;
     cov.threads = threads;
-    ASSIGN_OR_RETURN(out.coverage, ComputeCoverage(error_map, part, resolved, cov, cancel));
+    ASSIGN_OR_RETURN(out.coverage,
+                     ComputeCoverage(error_map, part, resolved, cov, cancel, grouped));
     out.coverage_run = true;
   }
   if (plan.defects) {
@@ -101,7 +119,7 @@ absl::StatusOr<PlanOutcome> EvaluatePlan(const ErrorMapResult& error_map, const 
                      FindDefects(error_map, cloud, part, *plan.defects, &resolved, ds));
     out.defects_run = true;
   }
-  ASSIGN_OR_RETURN(out.sections, CutSections(error_map, part, resolved));
+  ASSIGN_OR_RETURN(out.sections, CutSections(error_map, part, resolved, grouped));
   ASSIGN_OR_RETURN(auto holes, MeasureHoles(resolved.plan.holes, views, {}, cancel));
   ASSIGN_OR_RETURN(auto edges,
                    MeasureEdgePoints(resolved.plan.edge_points, part, views, {}, cancel));

@@ -81,17 +81,51 @@ std::vector<std::vector<Eigen::Vector3d>> Chain(const std::vector<Segment>& segm
   return out;
 }
 
+// Whether triangle t may hold closest points within the slab: its
+// vertices' offsets from the plane span the slab (widened by 1e-3 mm for
+// float rounding; each point is then tested exactly).
+bool NearSlab(const TriangleMesh& part, uint32_t t, const SectionPlane& plane) {
+  double lo = INFINITY, hi = -INFINITY;
+  for (uint32_t v : part.triangles[t]) {
+    const double s = (part.vertices[v].cast<double>() - plane.point_mm).dot(plane.normal);
+    lo = std::min(lo, s), hi = std::max(hi, s);
+  }
+  const double half = plane.width_mm / 2 + 1e-3;
+  return hi >= -half && lo <= half;
+}
+
+// The error-map indices of the matched points in the slab, ascending: from
+// the triangles near the slab when the points are grouped by triangle, else
+// by a pass over the map.
+std::vector<uint32_t> SlabPoints(const TriangleMesh& part, const ErrorMapResult& em,
+                                 const SectionPlane& plane, const std::vector<uint8_t>& triangles,
+                                 const TrianglePoints* by_triangle) {
+  std::vector<uint32_t> out;
+  const auto consider = [&](std::size_t i) {
+    const uint32_t t = em.triangle_id[i];
+    if (t == UINT32_MAX || (!triangles.empty() && !triangles[t])) return;
+    const double off = (em.closest_point[i].cast<double>() - plane.point_mm).dot(plane.normal);
+    if (std::abs(off) <= plane.width_mm / 2) out.push_back(static_cast<uint32_t>(i));
+  };
+  if (!by_triangle) {
+    for (std::size_t i = 0; i < em.triangle_id.size(); ++i) consider(i);
+    return out;
+  }
+  for (uint32_t t = 0; t < part.num_triangles(); ++t)
+    if ((triangles.empty() || triangles[t]) && NearSlab(part, t, plane))
+      for (uint32_t k = by_triangle->begin(t); k < by_triangle->end(t); ++k)
+        consider(by_triangle->points[k]);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 // The measured side: points in the slab, their statistics and whiskers.
 void MeasuredSide(const TriangleMesh& part, const ErrorMapResult& em, const SectionPlane& plane,
                   const std::vector<uint8_t>& triangles, std::size_t max_whiskers,
-                  SectionCut& cut) {
+                  const TrianglePoints* by_triangle, SectionCut& cut) {
+  cut.points = SlabPoints(part, em, plane, triangles, by_triangle);
   double sum = 0, lo = INFINITY, hi = -INFINITY;
-  for (std::size_t i = 0; i < em.triangle_id.size(); ++i) {
-    const uint32_t t = em.triangle_id[i];
-    if (t == UINT32_MAX || (!triangles.empty() && !triangles[t])) continue;
-    const double off = (em.closest_point[i].cast<double>() - plane.point_mm).dot(plane.normal);
-    if (std::abs(off) > plane.width_mm / 2) continue;
-    cut.points.push_back(static_cast<uint32_t>(i));
+  for (uint32_t i : cut.points) {
     const double d = em.deviation_mm[i];
     sum += d, lo = std::min(lo, d), hi = std::max(hi, d);
   }
@@ -116,7 +150,7 @@ void MeasuredSide(const TriangleMesh& part, const ErrorMapResult& em, const Sect
 absl::StatusOr<SectionCut> CutSection(const TriangleMesh& part, const ErrorMapResult& em,
                                       const SectionPlane& given,
                                       const std::vector<uint8_t>& triangles,
-                                      std::size_t max_whiskers) {
+                                      std::size_t max_whiskers, const TrianglePoints* by_triangle) {
   if (!given.normal.allFinite() || !(given.normal.norm() > 0) || !given.point_mm.allFinite())
     return absl::InvalidArgumentError("section: the plane needs a point and a non-zero normal");
   if (!(given.width_mm > 0) || !std::isfinite(given.width_mm))
@@ -126,9 +160,12 @@ absl::StatusOr<SectionCut> CutSection(const TriangleMesh& part, const ErrorMapRe
   if (em.closest_point.size() != em.triangle_id.size() ||
       em.deviation_mm.size() != em.triangle_id.size())
     return absl::InvalidArgumentError("section: error map arrays differ in size");
-  for (uint32_t t : em.triangle_id)
-    if (t != UINT32_MAX && t >= part.num_triangles())
-      return absl::InvalidArgumentError("section: triangle id beyond the part mesh");
+  if (by_triangle && by_triangle->offsets.size() != part.num_triangles() + 1)
+    return absl::InvalidArgumentError("section: the points by triangle are not the part's");
+  if (!by_triangle)  // grouping the points checked their ids
+    for (uint32_t t : em.triangle_id)
+      if (t != UINT32_MAX && t >= part.num_triangles())
+        return absl::InvalidArgumentError("section: triangle id beyond the part mesh");
   SectionPlane plane = given;
   plane.normal.normalize();
   std::vector<Segment> segments;
@@ -140,7 +177,7 @@ absl::StatusOr<SectionCut> CutSection(const TriangleMesh& part, const ErrorMapRe
   cut.plane = plane;
   cut.segments = segments.size();
   cut.polylines = Chain(segments);
-  MeasuredSide(part, em, plane, triangles, max_whiskers, cut);
+  MeasuredSide(part, em, plane, triangles, max_whiskers, by_triangle, cut);
   return cut;
 }
 

@@ -19,6 +19,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/errormap/error_map.h"
+#include "core/plan/triangle_points.h"
 #include "core/types/triangle_mesh.h"
 
 namespace surfinspect {
@@ -46,12 +47,18 @@ struct SectionCut {
   std::vector<SectionWhisker> whiskers;              // up to max_whiskers, evenly over `points`
 };
 
+inline constexpr std::size_t kDefaultMaxWhiskers = 400;
+
 // `triangles`, when not empty, limits the cut and the points to those CAD
-// triangles (a section limited to a region): 1 selects. InvalidArgument for
-// a zero normal, a width <= 0, or sizes that do not match the part.
+// triangles (a section limited to a region): 1 selects. `by_triangle`,
+// when given, is PointsByTriangle of the same map and part: only the
+// triangles near the slab are read (the same points as without it).
+// InvalidArgument for a zero normal, a width <= 0, or sizes that do not
+// match the part.
 absl::StatusOr<SectionCut> CutSection(const TriangleMesh& part, const ErrorMapResult& error_map,
                                       const SectionPlane& plane,
                                       const std::vector<uint8_t>& triangles = {},
-                                      std::size_t max_whiskers = 400);
+                                      std::size_t max_whiskers = kDefaultMaxWhiskers,
+                                      const TrianglePoints* by_triangle = nullptr);
 
 }  // namespace surfinspect

@@ -134,6 +134,34 @@ TEST(Coverage, EqualsADenseBruteForceSamplingOfTheArea) {
   EXPECT_EQ(one->surface, got->surface);
 }
 
+// A sheet folded at 90 degrees along x = 0: the top scanned only from 3 mm
+// off the fold. No point lies within reach of the flange, so it is not
+// covered; a point projected onto the flange's plane would land on its
+// edge and cover a strip there if every neighbour's points were taken.
+TEST(Coverage, APointBeyondAFoldDoesNotCoverTheOtherFace) {
+  TriangleMesh mesh;
+  mesh.vertices = {{0, 0, 0}, {10, 0, 0}, {10, 10, 0}, {0, 10, 0}, {0, 0, -10}, {0, 10, -10}};
+  mesh.triangles = {{0, 1, 2}, {0, 2, 3}, {0, 3, 5}, {0, 5, 4}};
+  std::vector<Eigen::Vector3f> points;
+  for (float x = 3; x <= 10; x += 0.25f)
+    for (float y = 0; y <= 10; y += 0.25f) points.emplace_back(x, y, 0.f);
+  auto index = MeshIndex::Build(mesh);
+  ASSERT_TRUE(index.ok());
+  auto em =
+      ComputeErrorMap(**index, PointCloud::Unorganized(points), Eigen::Isometry3d::Identity(), {});
+  ASSERT_TRUE(em.ok()) << em.status();
+  auto rp = ResolveInspectionPlan(InspectionPlan{}, mesh);
+  ASSERT_TRUE(rp.ok());
+  CoverageSettings cs;
+  cs.distance_mm = 0.8;
+  auto got = ComputeCoverage(*em, mesh, *rp, cs);
+  ASSERT_TRUE(got.ok()) << got.status();
+  EXPECT_EQ(got->triangles[2], 0.f);
+  EXPECT_EQ(got->triangles[3], 0.f);
+  // The top is seen from x = 3 - 0.8 on: (10 - 2.2) / 10 of it.
+  EXPECT_NEAR(0.5 * (got->triangles[0] + got->triangles[1]), 0.78, 0.02);
+}
+
 TEST(Coverage, AComparisonPointCountsTheSurfaceWithinItsRadius) {
   const Sheet s = MakeSheet();
   InspectionPlan plan;

@@ -96,8 +96,12 @@ TEST(Section, PointsAndValuesEqualABruteForceSelection) {
   std::vector<uint8_t> ridge(pillar.num_triangles(), 0);
   for (std::size_t t = 0; t < ridge.size(); ++t)
     ridge[t] = pillar.vertices[pillar.triangles[t][0]].z() > 40;
-  for (const std::vector<uint8_t>* mask : {&ridge, static_cast<std::vector<uint8_t>*>(nullptr)}) {
-    auto cut = CutSection(pillar, em, plane, mask ? *mask : std::vector<uint8_t>{}, 100);
+  auto grouped = PointsByTriangle(em, pillar.num_triangles());
+  ASSERT_TRUE(grouped.ok()) << grouped.status();
+  for (int run = 0; run < 4; ++run) {  // with and without the ridge mask, by a pass or grouped
+    const std::vector<uint8_t>* mask = run % 2 ? nullptr : &ridge;
+    auto cut = CutSection(pillar, em, plane, mask ? *mask : std::vector<uint8_t>{}, 100,
+                          run < 2 ? nullptr : &*grouped);
     ASSERT_TRUE(cut.ok()) << cut.status();
     std::vector<uint32_t> expect;
     double sum = 0, lo = INFINITY, hi = -INFINITY;
