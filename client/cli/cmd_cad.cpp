@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <numeric>
 
+#include "absl/strings/ascii.h"
 #include "client/cell/cell_part.h"
 #include "client/cli/commands.h"
 #include "core/cad/cad_import.h"
@@ -68,8 +69,19 @@ void AddCadCommand(CLI::App& app) {
   cmd->add_option("--in", a->in, "STEP (.step .stp) or IGES (.iges .igs) file, any length unit")
       ->required()
       ->check(CLI::ExistingFile);
+  // The mesh is OBJ whatever the name says; another extension would be
+  // read back as that format and refused, or worse.
+  const CLI::Validator obj(
+      [](std::string& path) {
+        const std::string ext = std::filesystem::path(path).extension().string();
+        return absl::AsciiStrToLower(ext) == ".obj"
+                   ? std::string()
+                   : "must end in .obj: the mesh is written as OBJ, with its groups";
+      },
+      "OBJ");
   cmd->add_option("--out", a->out, "mesh to write: OBJ with groups face:N, name:, color:, body:")
-      ->required();
+      ->required()
+      ->check(obj);
   cmd->add_option("--report", a->report, "report JSON (default: OUT with .cad.json)");
   cmd->add_option("--chord-tolerance", a->settings.tessellation.chord_tolerance_mm,
                   "largest measured distance between surface and triangles, mm")

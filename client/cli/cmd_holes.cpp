@@ -41,8 +41,9 @@ void RunHoles(const HolesArgs& a) {
 }  // namespace
 
 void AddHolesCommand(CLI::App& app) {
-  auto* cmd = app.add_subcommand(
-      "holes", "List the holes and slots of a CAD mesh (boundary loops that are circles or slots)");
+  auto* cmd = app.add_subcommand("holes",
+                                 "List the holes and slots of a CAD mesh (boundary loops or a "
+                                 "solid's sharp rims that are circles or slots)");
   auto a = std::make_shared<HolesArgs>();
   cmd->add_option("mesh", a->mesh, "CAD mesh (.stl/.obj/.ply/.off)")->required();
   AddUnitOptions(cmd, a->units, true);

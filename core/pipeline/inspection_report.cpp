@@ -223,6 +223,7 @@ void VisitReport(V& v, R& r) {
     v.List("defects", r.defects, SURFINSPECT_VISIT(VisitDefect));
   }
   VisitReportSections(v, r.sections);
+  VisitReportCoverage(v, r.coverage);
   v.Object("inputs", r.inputs, SURFINSPECT_VISIT(VisitInputs));
   v.Object("mesh", r.mesh, SURFINSPECT_VISIT(VisitMesh));
   v.Object("cad", r.cad, SURFINSPECT_VISIT(VisitCad));
@@ -268,6 +269,7 @@ absl::StatusOr<InspectionReport> DecodeReport(const json& j) {
   VisitReport(r, report);
   if (!r.status().ok()) return r.status();
   if (absl::Status s = CheckReportSections(report.sections); !s.ok()) return s;
+  if (absl::Status s = CheckReportCoverage(report.coverage); !s.ok()) return s;
   return report;
 }
 
@@ -349,6 +351,7 @@ InspectionReport MakeInspectionReport(const ErrorMapResult& error_map,
     out.characteristics.push_back(ReportCharacteristicOf(c));
   for (const Defect& d : outcome.defects.defects) out.defects.push_back(ReportDefectOf(d));
   out.sections = ReportSectionsOf(outcome);
+  out.coverage = ReportCoverageOf(outcome);
   return out;
 }
 

@@ -21,6 +21,7 @@
 #include "absl/status/statusor.h"
 #include "core/cad/cad_report.h"
 #include "core/errormap/error_map.h"
+#include "core/pipeline/report_coverage.h"
 #include "core/pipeline/report_section.h"
 #include "core/plan/characteristics.h"
 #include "core/plan/defects.h"
@@ -152,6 +153,7 @@ struct InspectionReport {
   std::vector<ReportCharacteristic> characteristics;
   std::vector<ReportDefect> defects;
   std::vector<ReportSection> sections;  // the plan's sections, in plan order; "sections"
+  std::optional<ReportCoverage> coverage;  // where the scan saw the CAD; "coverage"
   // Written by the CLI's errormap only.
   std::optional<ReportInputs> inputs;
   std::optional<ReportMesh> mesh;

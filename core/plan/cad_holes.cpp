@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 #include <optional>
+#include <set>
 
 #include "core/plan/profile_fit.h"
 
@@ -43,6 +44,68 @@ std::vector<std::vector<uint32_t>> BoundaryLoops(const TriangleMesh& mesh) {
     if (closed && loop.size() >= 3) loops.push_back(std::move(loop));
   }
   return loops;
+}
+
+// A solid's hole rim: edges where two triangles meet at more than
+// kRimAngleDeg (the face meets the hole's cylinder wall at ~90 degrees; the
+// wall's own facets meet at 360/N degrees, far less at any sensible
+// tessellation), chained into closed loops through vertices on exactly two
+// such edges (a vertex where more meet, a box's corner, ends no hole rim).
+constexpr double kRimAngleDeg = 60;
+
+std::vector<std::vector<uint32_t>> RimLoops(const TriangleMesh& mesh) {
+  const std::vector<Eigen::Vector3f> normals = mesh.FaceNormals();
+  const std::vector<EdgeUse> uses = SortedEdgeUses(mesh);
+  const float cos_max = static_cast<float>(std::cos(kRimAngleDeg * M_PI / 180));
+  std::map<uint32_t, std::vector<uint32_t>> sharp;  // vertex -> its sharp edges' other ends
+  for (std::size_t i = 0; i + 1 < uses.size(); ++i) {
+    const bool pair = uses[i].edge == uses[i + 1].edge &&
+                      (i == 0 || uses[i - 1].edge != uses[i].edge) &&
+                      (i + 2 == uses.size() || uses[i + 2].edge != uses[i].edge);
+    if (!pair || !(normals[uses[i].triangle].dot(normals[uses[i + 1].triangle]) < cos_max))
+      continue;
+    const auto lo = static_cast<uint32_t>(uses[i].edge >> 32);
+    const auto hi = static_cast<uint32_t>(uses[i].edge);
+    sharp[lo].push_back(hi);
+    sharp[hi].push_back(lo);
+  }
+  std::vector<std::vector<uint32_t>> loops;
+  std::set<uint32_t> seen;
+  for (const auto& [first, ends] : sharp) {
+    if (ends.size() != 2 || !seen.insert(first).second) continue;
+    std::vector<uint32_t> loop{first};
+    uint32_t prev = first, at = ends[0];
+    while (at != first) {
+      const auto it = sharp.find(at);
+      if (it->second.size() != 2 || !seen.insert(at).second) break;
+      loop.push_back(at);
+      const uint32_t next = it->second[0] == prev ? it->second[1] : it->second[0];
+      prev = at, at = next;
+    }
+    if (at == first && loop.size() >= 3) loops.push_back(std::move(loop));
+  }
+  return loops;
+}
+
+// Whether the wall below a rim loop faces the hole's axis (a hole) rather
+// than away from it (a boss): over the triangles at the loop's vertices
+// that stand across the axis, their normals' radial parts.
+bool WallFacesAxis(const TriangleMesh& mesh, const std::vector<uint32_t>& loop,
+                   const CadHole& hole) {
+  const std::set<uint32_t> on(loop.begin(), loop.end());
+  double inward = 0;
+  for (const Triangle& t : mesh.triangles) {
+    if (!on.count(t[0]) && !on.count(t[1]) && !on.count(t[2])) continue;
+    const Eigen::Vector3d a = mesh.vertices[t[0]].cast<double>(),
+                          b = mesh.vertices[t[1]].cast<double>(),
+                          c = mesh.vertices[t[2]].cast<double>();
+    const Eigen::Vector3d n = (b - a).cross(c - a).normalized();
+    if (!n.allFinite() || std::abs(n.dot(hole.axis)) > 0.5) continue;  // the face, not the wall
+    Eigen::Vector3d radial = (a + b + c) / 3 - hole.position_mm;
+    radial -= radial.dot(hole.axis) * hole.axis;
+    inward -= n.dot(radial.normalized());
+  }
+  return inward > 0;
 }
 
 // Per vertex, the sum of its triangles' area-weighted normals: over a
@@ -134,10 +197,17 @@ PlaneFrame MakePlaneFrame(const Eigen::Vector3d& origin, const Eigen::Vector3d& 
 std::vector<CadHole> ListHoles(const TriangleMesh& mesh, const CadHoleSettings& settings) {
   std::vector<CadHole> holes;
   const auto loops = BoundaryLoops(mesh);
-  if (loops.empty()) return holes;
+  const auto rims = RimLoops(mesh);
+  if (loops.empty() && rims.empty()) return holes;
   const std::vector<Eigen::Vector3d> sides = VertexSides(mesh);
   for (const auto& loop : loops)
     if (auto hole = HoleOfLoop(mesh, sides, loop, settings)) holes.push_back(*hole);
+  for (const auto& loop : rims) {
+    auto hole = HoleOfLoop(mesh, sides, loop, settings);
+    if (!hole || !WallFacesAxis(mesh, loop, *hole)) continue;
+    hole->rim = true;
+    holes.push_back(*hole);
+  }
   std::sort(holes.begin(), holes.end(), [](const CadHole& a, const CadHole& b) {
     return std::lexicographical_compare(a.position_mm.data(), a.position_mm.data() + 3,
                                         b.position_mm.data(), b.position_mm.data() + 3);

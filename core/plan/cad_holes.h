@@ -2,8 +2,12 @@
 // boundary loop of the mesh (a chain of edges used by one triangle) that is
 // planar and whose vertices lie on a circle, or on a slot (a stadium), is a
 // hole. The outer boundary and irregular cut-outs fit neither and are left
-// out. A STEP solid's holes are closed cylinder walls, not boundary loops:
-// they are not found here (docs/inspection-plan.md#holes-and-slots).
+// out. A solid (a STEP part tessellated, a closed mesh) has no boundary:
+// its hole is a cylinder wall, found by its rims, the loops of sharp edges
+// (> 60 degrees) where a face meets a wall that faces the axis, each
+// listed with the axis its face looks to (both ends of a through hole; a
+// boss, whose wall faces away, is not a hole). A rim rounded by a fillet
+// has no sharp edge and is not found (docs/inspection-plan.md#holes-and-slots).
 //
 // Units mm, part frame. NearestBoundaryEdge gives the trim edge at a point.
 #pragma once
@@ -44,6 +48,7 @@ struct CadHole {
   double form_mm = 0;      // the loop's vertices about the fitted contour, max - min
   double flatness_mm = 0;  // the loop's vertices about its plane, max - min
   std::size_t vertices = 0;
+  bool rim = false;  // a solid's rim (sharp edges), not a boundary loop
 };
 
 struct CadHoleSettings {

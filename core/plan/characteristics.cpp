@@ -143,16 +143,18 @@ void JudgePoint(const ComparisonPoint& p, CharacteristicResult& c) {
                                                p.direction.y(), p.direction.z()));
 }
 
-// Not measured when its area was seen over less than it needs.
-void JudgeCoverage(double coverage, double min_coverage, CharacteristicResult& c) {
+// Not measured when its area (a section: its curve) was seen over less
+// than it needs.
+void JudgeCoverage(double coverage, double min_coverage, CharacteristicResult& c,
+                   const char* what = "CAD area") {
   c.coverage = coverage;
   c.min_coverage = min_coverage;
   if (!(coverage < min_coverage)) return;
   c.measured = false;
   c.pass = false;
-  c.reason = absl::StrFormat(
-      "not measured: %.1f%% of its CAD area seen, at least %.1f%% needed (%u points)",
-      100 * coverage, 100 * min_coverage, c.points);
+  c.reason =
+      absl::StrFormat("not measured: %.1f%% of its %s seen, at least %.1f%% needed (%u points)",
+                      100 * coverage, what, 100 * min_coverage, c.points);
 }
 
 // The k-th characteristic (surface, regions, points) judged.
@@ -210,6 +212,7 @@ CharacteristicResult JudgeSection(const ErrorMapResult& em, const InspectionPlan
   for (uint32_t i : cut.points) a.Add(em.deviation_mm[i], c.tolerance);
   FillStats(a, c);
   JudgeArea(c);
+  if (std::isfinite(cut.coverage)) JudgeCoverage(cut.coverage, plan.min_coverage, c, "curve");
   return c;
 }
 

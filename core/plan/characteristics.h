@@ -18,7 +18,9 @@
 //    when it has a value and that value is inside its band.
 //  * With a coverage (core/plan/coverage.h), a characteristic whose CAD
 //    area was seen over less than its min_coverage is not measured: it
-//    does not pass, whatever its few points say.
+//    does not pass, whatever its few points say. A section whose cut
+//    carries a coverage (SectionCoverage: of its curve's length) is judged
+//    so against the plan's min_coverage.
 //  * The part passes when every characteristic passes (those not measured
 //    are let through only when the plan allows it), and, when the plan
 //    sets defects.max_count, at most that many defects were found.

@@ -200,7 +200,7 @@ absl::Status CheckHoles(const InspectionPlan& plan, const TriangleMesh& part,
     if (!near)
       return Bad(path + ".position_mm",
                  absl::StrCat("no hole of the CAD there (", cad.size(),
-                              " found: boundary loops that are circles or slots)"));
+                              " found: boundary loops or solid rims that are circles or slots)"));
   }
   return absl::OkStatus();
 }

@@ -120,6 +120,9 @@ absl::StatusOr<PlanOutcome> EvaluatePlan(const ErrorMapResult& error_map, const 
     out.defects_run = true;
   }
   ASSIGN_OR_RETURN(out.sections, CutSections(error_map, part, resolved, grouped));
+  if (coverage)  // a section's curve is judged like an area
+    for (SectionCut& cut : out.sections)
+      cut.coverage = SectionCoverage(cut, error_map, out.coverage.distance_mm);
   ASSIGN_OR_RETURN(auto holes, MeasureHoles(resolved.plan.holes, views, {}, cancel));
   ASSIGN_OR_RETURN(auto edges,
                    MeasureEdgePoints(resolved.plan.edge_points, part, views, {}, cancel));

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <unordered_map>
 #include <utility>
 
 namespace surfinspect {
@@ -145,7 +146,59 @@ void MeasuredSide(const TriangleMesh& part, const ErrorMapResult& em, const Sect
   }
 }
 
+// The slab's closest points hashed by cells of `cell` mm, for the curve's
+// samples to find their neighbours among.
+class PointCells {
+ public:
+  PointCells(const SectionCut& cut, const ErrorMapResult& em, double cell) : em_(em), cell_(cell) {
+    for (uint32_t i : cut.points)
+      cells_[Key(Cell(em.closest_point[i].cast<double>()))].push_back(i);
+  }
+  // Whether a point lies within `cell` of q (in q's cell or one around it).
+  bool Near(const Eigen::Vector3d& q) const {
+    const Eigen::Vector3i c = Cell(q);
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          const auto it = cells_.find(Key(c + Eigen::Vector3i(dx, dy, dz)));
+          if (it == cells_.end()) continue;
+          for (uint32_t i : it->second)
+            if ((em_.closest_point[i].cast<double>() - q).squaredNorm() <= cell_ * cell_)
+              return true;
+        }
+    return false;
+  }
+
+ private:
+  Eigen::Vector3i Cell(const Eigen::Vector3d& p) const {
+    return (p / cell_).array().floor().max(-1e6).min(1e6).cast<int>();
+  }
+  static uint64_t Key(const Eigen::Vector3i& c) {
+    const auto u = [](int v) { return static_cast<uint64_t>(v + (1 << 20)) & 0x1fffff; };
+    return u(c.x()) << 42 | u(c.y()) << 21 | u(c.z());
+  }
+  const ErrorMapResult& em_;
+  double cell_;
+  std::unordered_map<uint64_t, std::vector<uint32_t>> cells_;
+};
+
 }  // namespace
+
+double SectionCoverage(const SectionCut& cut, const ErrorMapResult& em, double distance_mm) {
+  const PointCells cells(cut, em, distance_mm);
+  double total = 0, seen = 0;
+  for (const auto& line : cut.polylines)
+    for (std::size_t k = 0; k + 1 < line.size(); ++k) {
+      const Eigen::Vector3d a = line[k], b = line[k + 1];
+      const double length = (b - a).norm();
+      const int n = std::max(1, static_cast<int>(std::ceil(length / (distance_mm / 2))));
+      for (int j = 0; j < n; ++j) {
+        total += length / n;
+        if (cells.Near(a + (j + 0.5) / n * (b - a))) seen += length / n;
+      }
+    }
+  return total > 0 ? seen / total : 0;
+}
 
 absl::StatusOr<SectionCut> CutSection(const TriangleMesh& part, const ErrorMapResult& em,
                                       const SectionPlane& given,

@@ -45,6 +45,7 @@ struct SectionCut {
   std::vector<uint32_t> points;                      // error-map indices in the slab, ascending
   double min_mm = NAN, max_mm = NAN, mean_mm = NAN;  // over those points
   std::vector<SectionWhisker> whiskers;              // up to max_whiskers, evenly over `points`
+  double coverage = NAN;  // of the curve's length seen (SectionCoverage); NaN when not computed
 };
 
 inline constexpr std::size_t kDefaultMaxWhiskers = 400;
@@ -60,5 +61,11 @@ absl::StatusOr<SectionCut> CutSection(const TriangleMesh& part, const ErrorMapRe
                                       const std::vector<uint8_t>& triangles = {},
                                       std::size_t max_whiskers = kDefaultMaxWhiskers,
                                       const TrianglePoints* by_triangle = nullptr);
+
+// The fraction of the nominal curve's length that has a point of the slab
+// (its closest CAD point, as everywhere in coverage: core/plan/coverage.h)
+// within distance_mm: the curve sampled every distance_mm / 2, each sample
+// weighing its piece. 0 for a cut without a curve.
+double SectionCoverage(const SectionCut& cut, const ErrorMapResult& error_map, double distance_mm);
 
 }  // namespace surfinspect

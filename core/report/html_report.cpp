@@ -19,6 +19,20 @@ namespace {
 using nlohmann::json;
 
 // What the viewer reads: scale, palette, the payload's layout, defects.
+// The CAD triangles the scan did not wholly see (report.coverage), for the
+// view to grey out on the embedded mesh; null without coverage, without a
+// mesh, or when the listed ids do not fit the mesh (another CAD).
+json UnseenJson(const InspectionReport& report, const HtmlPayload& p) {
+  const std::size_t triangles = p.mesh_triangles.size() / 3;
+  if (!report.coverage || triangles == 0) return nullptr;
+  const ReportCoverage& c = *report.coverage;
+  if (!c.triangles.empty() && c.triangles.back() >= triangles) return nullptr;
+  return {{"distance_mm", c.distance_mm},
+          {"surface", c.surface},
+          {"triangles", c.triangles},
+          {"covered", c.covered}};
+}
+
 json ViewerData(const InspectionReport& report, const HtmlReportContext& ctx,
                 const DeviationPalette& palette, const HtmlPayload& p, std::string& blob) {
   json data = {{"kind", "report"},
@@ -43,6 +57,7 @@ json ViewerData(const InspectionReport& report, const HtmlReportContext& ctx,
   data["mesh"] = nullptr;
   data["mesh_omitted"] = p.mesh_omitted;
   if (!p.mesh_triangles.empty()) data["mesh"] = MeshJson(p.mesh_vertices, p.mesh_triangles, blob);
+  data["unseen"] = UnseenJson(report, p);
   data["defects"] = json::array();
   for (const ReportDefect& d : report.defects)
     data["defects"].push_back(
@@ -99,8 +114,12 @@ absl::StatusOr<HtmlReportPage> BuildPage(const HtmlReportInput& in) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   page.html = absl::StrCat(
       ViewerHead(Title(in.context, report)), VerdictBanner(report, in.context), "<main>\n",
-      ViewerPane("<label><input type=\"checkbox\" id=\"mesh-toggle\" checked> CAD mesh</label>"
-                 "<label><input type=\"checkbox\" id=\"defect-toggle\" checked> defects</label>"),
+      ViewerPane(absl::StrCat(
+          "<label><input type=\"checkbox\" id=\"mesh-toggle\" checked> CAD mesh</label>"
+          "<label><input type=\"checkbox\" id=\"defect-toggle\" checked> defects</label>",
+          data["unseen"].is_null()
+              ? ""
+              : "<label><input type=\"checkbox\" id=\"unseen-toggle\" checked> not seen</label>")),
       SidePane(report, in.context, palette), "</main>\n<footer>surfinspect report, three.js ",
       GetViewerAssets().three_version, "</footer>\n", ViewerScripts(data, payload_text));
   return page;

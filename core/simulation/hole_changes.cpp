@@ -31,6 +31,9 @@ absl::StatusOr<TriangleMesh> ChangeHoles(const TriangleMesh& cad,
       return absl::InvalidArgumentError(
           absl::StrCat("hole ", c.hole, ": the CAD has ", holes.size(), " holes"));
     const CadHole& h = holes[c.hole];
+    if (h.rim)
+      return absl::InvalidArgumentError(absl::StrCat(
+          "hole ", c.hole, ": a solid's rim; only holes that are boundary loops can be changed"));
     const PlaneFrame f = MakePlaneFrame(h.position_mm, h.axis, h.direction);
     const ProfileFit contour = NominalContour(h.slot, h.diameter_mm, h.length_mm);
     const Eigen::Vector3d shift = c.shift_mm - c.shift_mm.dot(f.axis) * f.axis;

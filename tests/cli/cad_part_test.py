@@ -131,6 +131,18 @@ class CadCommandTests(unittest.TestCase):
         self.assertIn("cut.stp", r.stderr)
         self.assertFalse(os.path.exists(self.path("cut.obj")))
 
+    def test_an_out_that_is_not_obj_is_refused_before_any_work(self):
+        # The mesh is OBJ; named .ply it would be read back as PLY and refused.
+        r = cli("cad", "--in", BRACKET, "--out", self.path("b.ply"), check=False)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("must end in .obj", r.stderr + r.stdout)
+        self.assertFalse(os.path.exists(self.path("b.ply")))
+
+    def test_holes_lists_the_rims_of_a_step_solid(self):
+        cli("cad", "--in", BRACKET, "--out", self.path("b.obj"))
+        r = cli("holes", self.path("b.obj"))
+        self.assertRegex(r.stdout, r"^[1-9]\d* holes and slots in ")
+
     def test_errormap_against_a_step_part_and_a_face_region(self):
         cli("cad", "--in", BRACKET, "--out", self.path("b.obj"))
         write_json(self.path("pose.json"), BRACKET_POSE)

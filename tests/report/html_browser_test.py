@@ -6,7 +6,9 @@ mouse events, Runtime.evaluate). Checks: no console errors; the WebGL canvas
 is drawn (most of it is not background, and the palette's colours are on it
 and on the legend); a click on a defect row and on a standard-view button
 each change the picture; hovering a point shows its deviation; the page's
-statistics equal report.json's. Prints the screenshots' paths and the time
+statistics equal report.json's. Then the same part inspected without its
+last two viewpoints: its page draws the CAD area not seen in grey
+(switching it off changes the picture) and says so. Prints the screenshots' paths and the time
 to interactive.
 
   html_browser_test.py BIN_DIR WORK_DIR
@@ -249,8 +251,21 @@ def calibrate(bin_dir, cell, work):
         log.close()
 
 
-def make_part(bin_dir, work):
+def make_part(bin_dir, work, drop=()):
+    """The demo cell's first part inspected; `drop` names viewpoints whose
+    scans are left out (a missing viewpoint: the CAD there is not seen)."""
     si = os.path.join(bin_dir, "surfinspect")
+    if drop:
+        cell = os.path.join(work, "cell", "cell.json")
+        scans = sorted(os.listdir(os.path.join(work, "cell", "scans")))[0]
+        part = os.path.join(work, "partial", scans)
+        os.makedirs(part, exist_ok=True)
+        for f in os.listdir(os.path.join(work, "cell", "scans", scans)):
+            if os.path.splitext(f)[0] not in drop:
+                shutil.copy(os.path.join(work, "cell", "scans", scans, f), part)
+        out = os.path.join(work, "results-partial", scans)
+        run([si, "inspect", "--cell", cell, "--scans", part, "--out", out])
+        return out
     run([si, "demo-cell", "--out", os.path.join(work, "cell"), "--parts", "1"])
     cell = os.path.join(work, "cell", "cell.json")
     calibrate(bin_dir, cell, work)
@@ -364,6 +379,7 @@ def main():
                state["preview_points"], preview_ms, full_ms), flush=True)
         dt.pump(0.3)
         checks(dt, shots, report, state)
+        check_unseen(dt, shots, make_part(bin_dir, work, drop=("v4", "v5")))
     finally:
         proc.terminate()
         try:
@@ -372,6 +388,50 @@ def main():
             proc.kill()
         shutil.rmtree(profile, ignore_errors=True)
     print("OK in %.1f s" % (time.time() - started))
+
+
+def open_page(dt, html):
+    """Navigates to `html` and waits until the viewer says it is ready."""
+    t0 = time.time()
+    dt.call("Page.navigate", url="file://" + os.path.abspath(html))
+    while time.time() - t0 < 30:
+        try:
+            if dt.eval("!!(window.surfinspect && window.surfinspect.ready)"):
+                dt.settle("loading " + os.path.basename(html))
+                return
+        except RuntimeError:
+            pass
+        time.sleep(0.05)
+    fail("%s did not become ready in 30 s; errors: %s" % (html, dt.errors))
+
+
+def check_unseen(dt, shots, out):
+    """The part inspected without its last two viewpoints: its report lists
+    the CAD triangles not seen, the page draws them grey (switching them off
+    changes the picture) and says how much was seen."""
+    report = json.load(open(os.path.join(out, "report.json")))
+    coverage = report.get("coverage")
+    if not coverage or coverage["surface"] > 0.95 or len(coverage["triangles"]) < 50:
+        fail("without two viewpoints the report should list unseen CAD: %s" %
+             (coverage and {k: coverage[k] for k in ("surface", "distance_mm")}))
+    open_page(dt, os.path.join(out, "report.html"))
+    note = dt.eval("document.getElementById('viewer-note').textContent")
+    if "grey: CAD not seen" not in note:
+        fail("the page does not say what the grey is: %r" % note[:300])
+    path1, with_grey, _ = check_drawn(dt, shots, "5_unseen")
+    toggle = rect_of(dt, "#unseen-toggle")
+    dt.click(toggle["x"] + toggle["width"] / 2, toggle["y"] + toggle["height"] / 2)
+    dt.settle("the click on 'not seen'")
+    path2, without, _ = check_drawn(dt, shots, "6_unseen_off")
+    changed = sum(1 for a, b in zip(with_grey, without) if not near(a, b, 8)) / len(with_grey)
+    print("screenshots %s, %s: %.1f%% of the canvas changed when the grey of %d unseen triangles "
+          "(%.1f%% of the surface seen) was switched off" %
+          (path1, path2, 100 * changed, len(coverage["triangles"]), 100 * coverage["surface"]),
+          flush=True)
+    if changed < 0.005:
+        fail("switching off the unseen CAD area did not change the picture")
+    if dt.errors or dt.eval("window.surfinspect.errors"):
+        fail("console errors on the partial part's page: %s" % dt.errors)
 
 
 def checks(dt, shots, report, state):

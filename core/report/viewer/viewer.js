@@ -4,7 +4,8 @@
 // data.kind:
 // - 'report' (report.html, core/report/html_report.h): the scanned points
 //   in the part frame, coloured by the error map's palette index computed in
-//   C++ (core/report/html_payload.h), the CAD mesh as a translucent overlay,
+//   C++ (core/report/html_payload.h), the CAD mesh as a translucent overlay
+//   with the area the scan did not see in grey,
 //   the defects with their ids;
 // - 'trend_map' (trend.html, core/history/trend_html.h): the CAD mesh with
 //   each triangle coloured by its mean deviation over the parts, or by its
@@ -124,6 +125,31 @@ function buildMesh(bytes, centre) {
   return new THREE.Mesh(geometry, material);
 }
 
+// The CAD triangles the scan did not wholly see (data.unseen, from
+// report.coverage), grey over the mesh: the more of a triangle went unseen,
+// the more opaque. A triangle's own vertices, so each has its shade.
+function buildUnseen(mesh) {
+  const U = data.unseen;
+  if (!mesh || !U || U.triangles.length === 0) return null;
+  const at = mesh.geometry.getAttribute('position').array, index = mesh.geometry.getIndex().array;
+  const n = U.triangles.length, position = new Float32Array(9 * n), colour = new Float32Array(12 * n);
+  for (let k = 0; k < n; ++k) {
+    const t = U.triangles[k], alpha = 0.25 + 0.6 * (1 - U.covered[k]);
+    for (let c = 0; c < 3; ++c) {
+      const v = index[3 * t + c];
+      for (let a = 0; a < 3; ++a) position[9 * k + 3 * c + a] = at[3 * v + a];
+      colour.set([0.42, 0.42, 0.47, alpha], 12 * k + 4 * c);
+    }
+  }
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.BufferAttribute(position, 3));
+  geometry.setAttribute('color', new THREE.BufferAttribute(colour, 4));  // RGBA: alpha per vertex
+  const material = new THREE.MeshBasicMaterial({
+    vertexColors: true, transparent: true, depthWrite: false, side: THREE.DoubleSide,
+  });
+  return new THREE.Mesh(geometry, material);
+}
+
 // scale: {tol, range, signed, title, none}: the colour bar of paletteIndex
 // over [-range, range] (or [0, range] when not signed), ticks at the band and
 // range ends, and the colour of `none` (no value).
@@ -225,7 +251,9 @@ function reportMain() {
   note.textContent = `${P.shown.toLocaleString('en')} of ${P.finite.toLocaleString('en')} points shown` +
     (P.thinned ? ` (thinned on a grid: up to ${P.per_cell} per ${P.cell_mm.toPrecision(3)} mm cell, ` +
       'largest |deviation| first; the statistics are over all points)' : '') +
-    (data.mesh_omitted ? '; the CAD mesh is too large to embed' : '');
+    (data.mesh_omitted ? '; the CAD mesh is too large to embed' : '') +
+    (data.unseen ? `; grey: CAD not seen within ${data.unseen.distance_mm} mm ` +
+      `(${(100 * data.unseen.surface).toFixed(1)}% of the surface seen)` : '');
   drawLegend(document.getElementById('legend'), {
     tol: data.tolerance_mm, range: data.range_mm, signed: true, title: 'deviation', none: 'unmatched',
   });
@@ -236,14 +264,15 @@ function reportMain() {
   const points = buildPoints(bytes, centre);
   const preview = buildPreview(points, P.shown);
   const mesh = buildMesh(bytes, centre);
+  const unseen = buildUnseen(mesh);
   mark('built');
   const view = createView(points.geometry.boundingSphere.radius || 1, centre);
   view.points = points;
   view.preview = preview;
-  for (const o of [points, preview, mesh]) if (o) view.scene.add(o);
+  for (const o of [points, preview, mesh, unseen]) if (o) view.scene.add(o);
   view.defects = addDefects(view.scene, centre, view.radius);
   wireCamera(view, (e) => pick(view, e));
-  wireReport(view, mesh);
+  wireReport(view, mesh, unseen);
   state.shown = P.shown;
   state.preview_points = preview ? PREVIEW_POINTS : P.shown;
   showView(view);
@@ -379,10 +408,15 @@ function wireCamera(view, onPick) {
 }
 
 // report.html's switches and its defect rows.
-function wireReport(view, mesh) {
+function wireReport(view, mesh, unseen) {
   const meshToggle = document.getElementById('mesh-toggle');
   meshToggle.disabled = !mesh;
   meshToggle.addEventListener('change', () => { if (mesh) mesh.visible = meshToggle.checked; changed(view); });
+  const unseenToggle = document.getElementById('unseen-toggle');
+  if (unseenToggle) {
+    unseenToggle.disabled = !unseen;
+    unseenToggle.addEventListener('change', () => { if (unseen) unseen.visible = unseenToggle.checked; changed(view); });
+  }
   const defectToggle = document.getElementById('defect-toggle');
   defectToggle.addEventListener('change', () => {
     for (const m of view.defects) m.ring.visible = defectToggle.checked;

@@ -220,6 +220,41 @@ TEST(PlanEvaluation, ASectionIsJudgedOnThePointsInItsSlab) {
   }
 }
 
+// A section's curve is judged like an area: its coverage is the share of
+// the curve with a slab point within the coverage distance (brute force
+// below, over every slab point for dense samples of the curve), and below
+// the plan's min_coverage it is not measured.
+TEST(PlanEvaluation, ASectionSeenOverLessOfItsCurveThanNeededIsNotMeasured) {
+  const Scene s = MakeScene();
+  nlohmann::json j = PlanJson();
+  j["sections"] = nlohmann::json::parse(R"([{"name": "S20", "point_mm": [20, 0, 0],
+      "normal": [1, 0, 0], "width_mm": 0.5, "tolerance_mm": {"lower": -0.25, "upper": 0.25}}])");
+  for (double min_coverage : {0.6, 0.9}) {
+    j["min_coverage"] = min_coverage;
+    auto plan = ParsePlanWithDefaults(j, s.mesh, {});
+    ASSERT_TRUE(plan.ok()) << plan.status();
+    auto out = EvaluatePlan(s.error_map, s.cloud, s.mesh, *plan);
+    ASSERT_TRUE(out.ok()) << out.status();
+    const CharacteristicResult& c = out->characteristics.characteristics.back();
+    const SectionCut& cut = out->sections[0];
+    const double d = out->coverage.distance_mm;
+    std::size_t seen = 0, samples = 0;
+    for (double y = 0.0005; y < 50; y += 0.001, ++samples)
+      for (uint32_t i : cut.points)
+        if ((s.error_map.closest_point[i].cast<double>() - Eigen::Vector3d(20, y, 0)).norm() <= d) {
+          ++seen;
+          break;
+        }
+    const double truth = static_cast<double>(seen) / static_cast<double>(samples);
+    EXPECT_NEAR(c.coverage, truth, 0.01);
+    EXPECT_NEAR(truth, 0.84, 0.03) << "seen over y in [5 - d, 44.75 + d] of [0, 50]";
+    EXPECT_EQ(c.measured, min_coverage < truth) << c.reason;
+    if (!c.measured) {
+      EXPECT_NE(c.reason.find("of its curve seen"), std::string::npos) << c.reason;
+    }
+  }
+}
+
 TEST(PlanEvaluation, ReportTwoKeepsTheErrorMapBlocksAndAddsTheResults) {
   const Scene s = MakeScene();
   auto plan = ParsePlanWithDefaults(PlanJson(), s.mesh, {});
@@ -229,7 +264,8 @@ TEST(PlanEvaluation, ReportTwoKeepsTheErrorMapBlocksAndAddsTheResults) {
   const nlohmann::json old = ErrorMapReportJson(s.error_map, {});
   const nlohmann::json j = EncodeReport(MakeInspectionReport(s.error_map, {}, *out));
   for (const auto& [key, value] : old.items()) EXPECT_EQ(j.at(key), value) << key;
-  EXPECT_EQ(j.size(), old.size() + 4);
+  EXPECT_EQ(j.size(), old.size() + 5);  // schema, verdict, characteristics, defects, coverage
+  EXPECT_TRUE(j.contains("coverage")) << "the plan judged coverage";
   EXPECT_EQ(j["schema"], "surfinspect.report/2");
   EXPECT_EQ(j["verdict"], "fail");
   EXPECT_EQ(j["characteristics"], CharacteristicsJson(out->characteristics));

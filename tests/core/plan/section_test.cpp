@@ -128,6 +128,57 @@ TEST(Section, PointsAndValuesEqualABruteForceSelection) {
   }
 }
 
+// SectionCoverage against a dense brute-force sampling of the curve, on
+// the random points of the test above with a band of y removed.
+TEST(Section, CoverageEqualsABruteForceSamplingOfTheCurve) {
+  const TriangleMesh pillar = MakePillarMesh(300);
+  std::mt19937_64 rng(4);
+  std::uniform_int_distribution<uint32_t> tri(0, static_cast<uint32_t>(pillar.num_triangles() - 1));
+  std::uniform_real_distribution<double> u(0, 1);
+  ErrorMapResult em;
+  for (int k = 0; k < 300000; ++k) {
+    const uint32_t t = tri(rng);
+    double a = u(rng), b = u(rng);
+    if (a + b > 1) a = 1 - a, b = 1 - b;
+    const auto& v = pillar.triangles[t];
+    const Eigen::Vector3f p0 = pillar.vertices[v[0]];
+    const Eigen::Vector3f p = p0 + static_cast<float>(a) * (pillar.vertices[v[1]] - p0) +
+                              static_cast<float>(b) * (pillar.vertices[v[2]] - p0);
+    if (p.y() > -10 && p.y() < 25) continue;  // not seen
+    em.closest_point.push_back(p);
+    em.triangle_id.push_back(t);
+    em.deviation_mm.push_back(0.f);
+  }
+  SectionPlane plane;
+  plane.point_mm = {-40, 3, 20};
+  plane.normal = Eigen::Vector3d(1, 0.3, 0).normalized();
+  plane.width_mm = 0.8;
+  auto cut = CutSection(pillar, em, plane);
+  ASSERT_TRUE(cut.ok()) << cut.status();
+  const double d = 1.0;
+  double length = 0, seen = 0;
+  for (const auto& line : cut->polylines)
+    for (std::size_t k = 0; k + 1 < line.size(); ++k) {
+      const double l = (line[k + 1] - line[k]).norm();
+      const int n = static_cast<int>(std::ceil(l / 0.005));
+      for (int j = 0; j < n; ++j) {
+        const Eigen::Vector3d q = line[k] + (j + 0.5) / n * (line[k + 1] - line[k]);
+        length += l / n;
+        for (uint32_t i : cut->points)
+          if ((em.closest_point[i].cast<double>() - q).norm() <= d) {
+            seen += l / n;
+            break;
+          }
+      }
+    }
+  const double got = SectionCoverage(*cut, em, d);
+  std::cout << "section coverage " << got << " (brute force " << seen / length << ")\n";
+  EXPECT_NEAR(got, seen / length, 0.01);
+  EXPECT_LT(got, 0.9) << "the band y in (-10, 25) was removed";
+  EXPECT_GT(got, 0.3);
+  EXPECT_EQ(SectionCoverage(SectionCut{}, em, d), 0.0) << "no curve";
+}
+
 TEST(Section, RefusesABadPlane) {
   const TriangleMesh pillar = MakePillarMesh(300);
   SectionPlane plane;
