@@ -55,9 +55,10 @@ EdgePointMeasurement Judge(const EdgeContour& c, const EdgeSamples& s, double ra
 absl::StatusOr<std::vector<EdgePointMeasurement>> MeasureEdgePoints(
     const std::vector<PlanEdgePoint>& points, const TriangleMesh& part,
     const std::vector<PlanView>& views, const EdgeSettings& settings,
-    const std::atomic<bool>* cancel) {
-  const std::vector<RayView> rays =
-      points.empty() ? std::vector<RayView>{} : PrepareRayViews(views);
+    const std::atomic<bool>* cancel, const std::vector<RayView>* prepared) {
+  const std::vector<RayView> own =
+      points.empty() || prepared ? std::vector<RayView>{} : PrepareRayViews(views);
+  const std::vector<RayView>& rays = prepared ? *prepared : own;
   std::vector<EdgePointMeasurement> out;
   for (const PlanEdgePoint& p : points) {
     if (IsCancelled(cancel)) return absl::CancelledError("edge points cancelled");

@@ -30,10 +30,11 @@ struct EdgePointMeasurement {
 };
 
 // One measurement per plan edge point, in plan order; `part` is the CAD
-// mesh the plan was validated against. No views: not measured.
+// mesh the plan was validated against. No views: not measured. `rays`,
+// when given, is PrepareRayViews(views) (as for MeasureHoles).
 absl::StatusOr<std::vector<EdgePointMeasurement>> MeasureEdgePoints(
     const std::vector<PlanEdgePoint>& points, const TriangleMesh& part,
     const std::vector<PlanView>& views, const EdgeSettings& settings = {},
-    const std::atomic<bool>* cancel = nullptr);
+    const std::atomic<bool>* cancel = nullptr, const std::vector<RayView>* rays = nullptr);
 
 }  // namespace surfinspect

@@ -113,8 +113,10 @@ EdgeContour ContourOf(const PlanHole& hole, double reach) {
 absl::StatusOr<std::vector<HoleMeasurement>> MeasureHoles(const std::vector<PlanHole>& holes,
                                                           const std::vector<PlanView>& views,
                                                           const EdgeSettings& settings,
-                                                          const std::atomic<bool>* cancel) {
-  const std::vector<RayView> rays = PrepareRayViews(views);
+                                                          const std::atomic<bool>* cancel,
+                                                          const std::vector<RayView>* prepared) {
+  const std::vector<RayView> own = prepared ? std::vector<RayView>{} : PrepareRayViews(views);
+  const std::vector<RayView>& rays = prepared ? *prepared : own;
   std::vector<HoleMeasurement> out;
   for (const PlanHole& hole : holes) {
     if (IsCancelled(cancel)) return absl::CancelledError("holes cancelled");

@@ -41,9 +41,11 @@ struct HoleMeasurement {
 
 // One measurement per plan hole, in plan order. `views` empty: every hole
 // is not measured (the reason says the organized views are needed).
-// Cancelled when `cancel` is raised.
+// `rays`, when given, is PrepareRayViews(views), made once by a caller that
+// also measures edge points. Cancelled when `cancel` is raised.
 absl::StatusOr<std::vector<HoleMeasurement>> MeasureHoles(
     const std::vector<PlanHole>& holes, const std::vector<PlanView>& views,
-    const EdgeSettings& settings = {}, const std::atomic<bool>* cancel = nullptr);
+    const EdgeSettings& settings = {}, const std::atomic<bool>* cancel = nullptr,
+    const std::vector<RayView>* rays = nullptr);
 
 }  // namespace surfinspect

@@ -123,9 +123,13 @@ absl::StatusOr<PlanOutcome> EvaluatePlan(const ErrorMapResult& error_map, const 
   if (coverage)  // a section's curve is judged like an area
     for (SectionCut& cut : out.sections)
       cut.coverage = SectionCoverage(cut, error_map, out.coverage.distance_mm);
-  ASSIGN_OR_RETURN(auto holes, MeasureHoles(resolved.plan.holes, views, {}, cancel));
+  // The views' pixel rays, fitted once for holes and edge points.
+  const std::vector<RayView> rays = plan.holes.empty() && plan.edge_points.empty()
+                                        ? std::vector<RayView>{}
+                                        : PrepareRayViews(views);
+  ASSIGN_OR_RETURN(auto holes, MeasureHoles(resolved.plan.holes, views, {}, cancel, &rays));
   ASSIGN_OR_RETURN(auto edges,
-                   MeasureEdgePoints(resolved.plan.edge_points, part, views, {}, cancel));
+                   MeasureEdgePoints(resolved.plan.edge_points, part, views, {}, cancel, &rays));
   CharacteristicsSettings cs;
   cs.threads = threads;
   ASSIGN_OR_RETURN(out.characteristics,

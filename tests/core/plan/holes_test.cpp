@@ -113,8 +113,15 @@ TEST(Holes, NoFalseVerdictOverTwentyPartsMadeAsDrawn) {
     const testing::ScannedPart s = testing::ScanMadePart(cell, made, seed);
     auto m = MeasureHoles(plan, s.plan_views);
     ASSERT_TRUE(m.ok()) << m.status();
+    // The rays prepared once by the caller (as EvaluatePlan does for holes
+    // and edge points) give the same bits.
+    const std::vector<RayView> rays = PrepareRayViews(s.plan_views);
+    auto again = MeasureHoles(plan, s.plan_views, {}, nullptr, &rays);
+    ASSERT_TRUE(again.ok());
     for (std::size_t k = 0; k < plan.size(); ++k) {
       const HoleMeasurement& r = (*m)[k];
+      EXPECT_EQ((*again)[k].measured_position_mm, r.measured_position_mm);
+      EXPECT_EQ((*again)[k].diameter_mm, r.diameter_mm);
       ASSERT_TRUE(r.measured) << "seed " << seed << " hole " << k << ": " << r.reason;
       EXPECT_LE(r.true_position_mm, plan[k].position_tolerance_mm) << seed << " " << k;
       EXPECT_TRUE(plan[k].diameter_tolerance.Contains(float(r.diameter_deviation_mm)))

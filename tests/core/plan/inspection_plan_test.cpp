@@ -230,8 +230,8 @@ TEST(InspectionPlan, HolesSlotsAndEdgePointsAreCheckedAgainstTheCad) {
       {[](json& p) {
          p["holes"][0]["position_mm"] = {0, 0, 60};
        },
-       "plan.holes[0].position_mm: no hole of the CAD there (6 found: boundary loops that are "
-       "circles or slots)"},
+       "plan.holes[0].position_mm: no hole of the CAD there (6 found: boundary loops or solid "
+       "rims that are circles or slots)"},
       {[](json& p) {
          p["holes"][1]["axis"] = {0, 0, 0};
        },
