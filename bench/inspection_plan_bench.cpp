@@ -40,6 +40,34 @@ double BestOf3(const std::function<void()>& f) {
   return best;
 }
 
+// The demo cell's part seen from its top viewpoint, and its error map
+// (timed best of 3, 2 threads).
+struct MappedView {
+  SimulatedScan scan;
+  PointCloud cloud;  // world frame
+  ErrorMapResult em;
+  double map_seconds = 0;
+  Eigen::Isometry3d part_from_sensor;
+};
+absl::StatusOr<MappedView> MapTopView(const DemoCell& cell, const SensorIntrinsics& in,
+                                      const ScanOptions& opt) {
+  const DemoViewpoint& vp = cell.viewpoints[2];
+  auto scan = SimulateScan(cell.part, cell.world_from_part, vp.world_from_sensor, in, opt);
+  if (!scan.ok()) return scan.status();
+  MappedView v{*std::move(scan), {}, {}, 0, cell.world_from_part.inverse() * vp.world_from_sensor};
+  v.cloud = TransformCloud(v.scan.cloud_in_sensor, vp.world_from_sensor);
+  auto index = MeshIndex::Build(cell.part);
+  if (!index.ok()) return index.status();
+  ErrorMapSettings es;
+  es.threads = 2;
+  absl::StatusOr<ErrorMapResult> em;
+  v.map_seconds =
+      BestOf3([&] { em = ComputeErrorMap(**index, v.cloud, cell.world_from_part, es); });
+  if (!em.ok()) return em.status();
+  v.em = *std::move(em);
+  return v;
+}
+
 InspectionPlan TwentyRegionsFiftyPoints() {
   InspectionPlan plan;
   plan.tolerance = {-0.1, 0.1};
@@ -93,20 +121,14 @@ nlohmann::json DrawingPlan(const TriangleMesh& part, bool holes, bool sections, 
 int RunDrawingPlan(const SensorIntrinsics& in, const ScanOptions& opt) {
   DemoCell cell = MakeDemoCell();
   cell.part = MakePillarMesh(cell.part_length_mm, TwentyHoles());
-  const DemoViewpoint& vp = cell.viewpoints[2];
-  auto scan = SimulateScan(cell.part, cell.world_from_part, vp.world_from_sensor, in, opt);
-  if (!scan.ok()) return 1;
-  const PointCloud cloud = TransformCloud(scan->cloud_in_sensor, vp.world_from_sensor);
-  auto index = MeshIndex::Build(cell.part);
-  if (!index.ok()) return 1;
+  auto view = MapTopView(cell, in, opt);
+  if (!view.ok()) return std::fprintf(stderr, "%s\n", view.status().ToString().c_str()), 1;
+  const PointCloud& cloud = view->cloud;
+  const ErrorMapResult* em = &view->em;
+  const double t_map = view->map_seconds;
   ErrorMapSettings es;
-  es.threads = 2;
-  absl::StatusOr<ErrorMapResult> em;
-  const double t_map =
-      BestOf3([&] { em = ComputeErrorMap(**index, cloud, cell.world_from_part, es); });
-  if (!em.ok()) return 1;
   const std::vector<PlanView> views = {
-      {"top", &scan->cloud_in_sensor, cell.world_from_part.inverse() * vp.world_from_sensor}};
+      {"top", &view->scan.cloud_in_sensor, view->part_from_sensor}};
   const auto time_plan = [&](bool holes, bool sections, bool coverage, std::size_t* measured) {
     auto plan =
         ParsePlanWithDefaults(DrawingPlan(cell.part, holes, sections, coverage), cell.part, es);
@@ -149,18 +171,11 @@ int Run() {
   ScanOptions opt;
   opt.noise_sigma_mm = 0.015;
   opt.defects = {{{-40, 5, 59.8}, 5, 0.2}, {{50, -8, 59.7}, 4, -0.1}};
-  const DemoViewpoint& vp = cell.viewpoints[2];
-  auto scan = SimulateScan(cell.part, cell.world_from_part, vp.world_from_sensor, in, opt);
-  if (!scan.ok()) return std::fprintf(stderr, "%s\n", scan.status().ToString().c_str()), 1;
-  const PointCloud cloud = TransformCloud(scan->cloud_in_sensor, vp.world_from_sensor);
-  auto index = MeshIndex::Build(cell.part);
-  if (!index.ok()) return 1;
-  ErrorMapSettings es;
-  es.threads = 2;
-  absl::StatusOr<ErrorMapResult> em;
-  const double t_map =
-      BestOf3([&] { em = ComputeErrorMap(**index, cloud, cell.world_from_part, es); });
-  if (!em.ok()) return 1;
+  auto view = MapTopView(cell, in, opt);
+  if (!view.ok()) return std::fprintf(stderr, "%s\n", view.status().ToString().c_str()), 1;
+  const PointCloud& cloud = view->cloud;
+  const ErrorMapResult* em = &view->em;
+  const double t_map = view->map_seconds;
   const double matched = static_cast<double>(em->stats.matched);
 
   const InspectionPlan plan = TwentyRegionsFiftyPoints();

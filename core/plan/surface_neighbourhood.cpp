@@ -221,12 +221,6 @@ std::unique_ptr<SurfaceNeighbourhood> MakeCellNeighbourhood(const ErrorMapResult
   return std::make_unique<CellNeighbourhood>(em, cloud, radius_mm, link_mm);
 }
 
-double MedianInPlace(std::vector<double>& v) { return Percentiles<double>(v).At(0.5); }
-
-double MadSigma(std::vector<double>& abs_residuals) {
-  return 1.4826 * MedianInPlace(abs_residuals);
-}
-
 double EstimateSurfaceSpacing(const ErrorMapResult& em, const PointCloud& cloud) {
   const auto& p = cloud.points;
   std::vector<double> d;

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "core/errormap/error_map.h"
+#include "core/types/percentile.h"  // MedianInPlace, MadSigma, for the plan's robust fits
 #include "core/types/point_cloud.h"
 
 namespace surfinspect {
@@ -60,15 +61,5 @@ std::unique_ptr<SurfaceNeighbourhood> MakeCellNeighbourhood(const ErrorMapResult
 // nearest neighbours far closer than the sampling) count as the denser
 // sampling they are. 1 mm when no spacing can be estimated.
 double EstimateSurfaceSpacing(const ErrorMapResult& error_map, const PointCloud& cloud);
-
-// The median of v: the report's one percentile definition at q = 0.5 (the
-// mean of the two middle values for an even count); reorders v. NaN when v
-// is empty.
-double MedianInPlace(std::vector<double>& v);
-
-// The robust sigma of residuals from their absolute values: 1.4826 times
-// their median (the MAD, scaled to a normal's standard deviation; Rousseeuw
-// and Croux, JASA 88 (1993)). Reorders `abs_residuals`; NaN when empty.
-double MadSigma(std::vector<double>& abs_residuals);
 
 }  // namespace surfinspect

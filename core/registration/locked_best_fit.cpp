@@ -10,6 +10,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/types/cancel.h"
+#include "core/types/percentile.h"
 #include "core/types/status_macros.h"
 
 namespace surfinspect {
@@ -51,19 +52,14 @@ absl::Status Correspond(const MeshIndex& mesh, const PointCloud& points, const R
       });
 }
 
-// σ = 1.4826·median|r| (the MAD about 0, scaled to a normal's standard
-// deviation; Rousseeuw & Croux, JASA 88 (1993)), at least `floor_mm`. The
-// median of an even count is the mean of the two middle values.
+// σ = MadSigma of the residuals (core/types/percentile.h), at least
+// `floor_mm`.
 double RobustScale(const std::vector<Pair>& pairs, double floor_mm) {
   std::vector<double> a;
   for (const Pair& p : pairs)
     if (!std::isnan(p.r)) a.push_back(std::abs(p.r));
   if (a.empty()) return floor_mm;
-  const std::size_t mid = a.size() / 2;
-  std::nth_element(a.begin(), a.begin() + mid, a.end());
-  double median = a[mid];
-  if (a.size() % 2 == 0) median = 0.5 * (median + *std::max_element(a.begin(), a.begin() + mid));
-  return std::max(1.4826 * median, floor_mm);
+  return std::max(MadSigma(a), floor_mm);
 }
 
 // IRLS weight of a residual with cut-off c: Huber min(1, c/|r|), Tukey's

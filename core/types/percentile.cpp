@@ -25,6 +25,12 @@ double Percentiles<T>::At(double q) {
 template class Percentiles<float>;
 template class Percentiles<double>;
 
+double MedianInPlace(std::vector<double>& v) { return Percentiles<double>(v).At(0.5); }
+
+double MadSigma(std::vector<double>& abs_residuals) {
+  return 1.4826 * MedianInPlace(abs_residuals);
+}
+
 namespace {
 
 // Orders as the floats do (-0 just below +0; no NaN among the values).

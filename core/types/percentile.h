@@ -28,6 +28,15 @@ class Percentiles {
 extern template class Percentiles<float>;
 extern template class Percentiles<double>;
 
+// The median of v: P(0.5) (the mean of the two middle values for an even
+// count); reorders v. NaN when v is empty.
+double MedianInPlace(std::vector<double>& v);
+
+// The robust sigma of residuals from their absolute values: 1.4826 times
+// their median (the MAD, scaled to a normal's standard deviation; Rousseeuw
+// and Croux, JASA 88 (1993)). Reorders `abs_residuals`; NaN when empty.
+double MadSigma(std::vector<double>& abs_residuals);
+
 // P(q) for each q of `qs` (at most 100, each in [0, 1); NaN otherwise or
 // for no values)
 // over floats, leaving `values` as they are: one pass counts the values by

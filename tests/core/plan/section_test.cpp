@@ -21,6 +21,20 @@ double Length(const std::vector<Eigen::Vector3d>& line) {
   return l;
 }
 
+// A random triangle of `mesh` and a uniform random point on it.
+std::pair<uint32_t, Eigen::Vector3f> RandomSurfacePoint(const TriangleMesh& mesh,
+                                                        std::mt19937_64& rng) {
+  std::uniform_int_distribution<uint32_t> tri(0, static_cast<uint32_t>(mesh.num_triangles() - 1));
+  std::uniform_real_distribution<double> u(0, 1);
+  const uint32_t t = tri(rng);
+  double a = u(rng), b = u(rng);
+  if (a + b > 1) a = 1 - a, b = 1 - b;
+  const auto& v = mesh.triangles[t];
+  const Eigen::Vector3f p0 = mesh.vertices[v[0]];
+  return {t, p0 + static_cast<float>(a) * (mesh.vertices[v[1]] - p0) +
+                 static_cast<float>(b) * (mesh.vertices[v[2]] - p0)};
+}
+
 TEST(Section, ThePillarCutAcrossIsItsProfile) {
   const TriangleMesh pillar = MakePillarMesh(300);
   // Rings of the extrusion every 5 mm from x = -150: 61 rings.
@@ -75,17 +89,11 @@ TEST(Section, ASphereCutThroughItsCentreIsOneClosedLoop) {
 TEST(Section, PointsAndValuesEqualABruteForceSelection) {
   const TriangleMesh pillar = MakePillarMesh(300);
   std::mt19937_64 rng(9);
-  std::uniform_int_distribution<uint32_t> tri(0, static_cast<uint32_t>(pillar.num_triangles() - 1));
-  std::uniform_real_distribution<double> u(0, 1), dev(-0.3, 0.3);
+  std::uniform_real_distribution<double> dev(-0.3, 0.3);
   ErrorMapResult em;
   for (int k = 0; k < 200000; ++k) {
-    const uint32_t t = tri(rng);
-    double a = u(rng), b = u(rng);
-    if (a + b > 1) a = 1 - a, b = 1 - b;
-    const auto& v = pillar.triangles[t];
-    const Eigen::Vector3f p0 = pillar.vertices[v[0]];
-    em.closest_point.push_back(p0 + static_cast<float>(a) * (pillar.vertices[v[1]] - p0) +
-                               static_cast<float>(b) * (pillar.vertices[v[2]] - p0));
+    const auto [t, p] = RandomSurfacePoint(pillar, rng);
+    em.closest_point.push_back(p);
     em.triangle_id.push_back(k % 50 == 0 ? UINT32_MAX : t);  // some unmatched
     em.deviation_mm.push_back(k % 50 == 0 ? NAN : static_cast<float>(dev(rng)));
   }
@@ -133,17 +141,9 @@ TEST(Section, PointsAndValuesEqualABruteForceSelection) {
 TEST(Section, CoverageEqualsABruteForceSamplingOfTheCurve) {
   const TriangleMesh pillar = MakePillarMesh(300);
   std::mt19937_64 rng(4);
-  std::uniform_int_distribution<uint32_t> tri(0, static_cast<uint32_t>(pillar.num_triangles() - 1));
-  std::uniform_real_distribution<double> u(0, 1);
   ErrorMapResult em;
   for (int k = 0; k < 300000; ++k) {
-    const uint32_t t = tri(rng);
-    double a = u(rng), b = u(rng);
-    if (a + b > 1) a = 1 - a, b = 1 - b;
-    const auto& v = pillar.triangles[t];
-    const Eigen::Vector3f p0 = pillar.vertices[v[0]];
-    const Eigen::Vector3f p = p0 + static_cast<float>(a) * (pillar.vertices[v[1]] - p0) +
-                              static_cast<float>(b) * (pillar.vertices[v[2]] - p0);
+    const auto [t, p] = RandomSurfacePoint(pillar, rng);
     if (p.y() > -10 && p.y() < 25) continue;  // not seen
     em.closest_point.push_back(p);
     em.triangle_id.push_back(t);

@@ -139,12 +139,5 @@ TEST(SurfaceNeighbourhood, SpacingOfGridsAndUnorganizedClouds) {
   EXPECT_NEAR(unorganized, 0.25 * std::sqrt(31.0 / 30 * 13.0 / 12), 0.02);
 }
 
-TEST(SurfaceNeighbourhood, Median) {
-  std::vector<double> odd = {5, 1, 3}, even = {4, 1, 3, 2}, none;
-  EXPECT_EQ(MedianInPlace(odd), 3);
-  EXPECT_EQ(MedianInPlace(even), 2.5);
-  EXPECT_TRUE(std::isnan(MedianInPlace(none)));
-}
-
 }  // namespace
 }  // namespace surfinspect

@@ -85,5 +85,15 @@ TEST(Percentile, FloatPercentilesEqualTheSelectionToTheBit) {
   EXPECT_TRUE(std::isnan(FloatPercentiles({1.f, 2.f}, {1.0})[0]));
 }
 
+TEST(Percentile, MedianAndMadSigma) {
+  std::vector<double> odd = {5, 1, 3}, even = {4, 1, 3, 2}, none;
+  EXPECT_EQ(MedianInPlace(odd), 3);
+  EXPECT_EQ(MedianInPlace(even), 2.5);
+  EXPECT_TRUE(std::isnan(MedianInPlace(none)));
+  std::vector<double> abs_residuals = {0.3, 0.1, 0.2, 0.4};  // median 0.25
+  EXPECT_DOUBLE_EQ(MadSigma(abs_residuals), 1.4826 * 0.25);
+  EXPECT_TRUE(std::isnan(MadSigma(none)));
+}
+
 }  // namespace
 }  // namespace surfinspect
