@@ -65,6 +65,8 @@ struct QifCharacteristic {
   bool has_values = false;
   double value = 0, worst_positive = 0, worst_negative = 0;  // the worst: profiles only
   int size_index = -1;  // position: the index of its hole's size characteristic
+  // A line profile (a section): the normal of the plane its curve lies in.
+  Eigen::Vector3d plane_normal = Eigen::Vector3d::Constant(NAN);
 };
 
 std::string Upper(const std::string& verdict) { return verdict == "pass" ? "PASS" : "FAIL"; }
@@ -76,17 +78,23 @@ std::string CharacteristicStatus(const std::string& verdict) {
   return verdict == "not_measured" ? "INDETERMINATE" : Upper(verdict);
 }
 
-// A surface, region or section is a surface profile of its points (a
-// section's slab too: a LineProfile with the section's plane, which
-// report.json's "sections" now carries, is not written yet); a comparison
-// point and a trim-edge point are point profiles.
+// A surface or region is a surface profile of its points; a section a line
+// profile in its plane (report.json's "sections" carries the plane; a report
+// without it, from before sections were written, keeps the surface
+// profile); a comparison point and a trim-edge point are point profiles.
 absl::Status AddProfile(const ReportCharacteristic& c, const std::string& where,
+                        const std::vector<ReportSection>& sections,
                         std::vector<QifCharacteristic>& out) {
   QifCharacteristic q;
   // A trim-edge point is one offset: a point profile whose worst values are
   // that offset.
   const bool edge = c.type == "edge_point";
   q.kind = c.has_value() ? "PointProfile" : "SurfaceProfile";
+  for (const ReportSection& s : sections)
+    if (c.type == "section" && s.name == c.name && s.normal.norm() > 0) {
+      q.kind = "LineProfile";
+      q.plane_normal = s.normal.normalized();
+    }
   q.name = c.name;
   q.status = CharacteristicStatus(c.verdict);
   q.description = c.reason;
@@ -156,6 +164,7 @@ absl::Status AddHole(const ReportCharacteristic& c, const std::string& where,
 }
 
 absl::Status AddCharacteristic(const ReportCharacteristic& c, std::size_t k,
+                               const std::vector<ReportSection>& sections,
                                std::vector<QifCharacteristic>& out) {
   const std::string where = absl::StrCat("report.characteristics[", k, "]");
   if (!std::isfinite(c.tolerance.lower_mm) || !std::isfinite(c.tolerance.upper_mm))
@@ -166,13 +175,13 @@ absl::Status AddCharacteristic(const ReportCharacteristic& c, std::size_t k,
   if (c.type != "surface" && c.type != "region" && c.type != "point" && c.type != "section" &&
       c.type != "edge_point")
     return absl::InvalidArgumentError(absl::StrCat(where, ".type: unknown \"", c.type, "\""));
-  return AddProfile(c, where, out);
+  return AddProfile(c, where, sections, out);
 }
 
 absl::StatusOr<std::vector<QifCharacteristic>> ReadCharacteristics(const InspectionReport& report) {
   std::vector<QifCharacteristic> out;
   for (std::size_t k = 0; k < report.characteristics.size(); ++k)
-    RETURN_IF_ERROR(AddCharacteristic(report.characteristics[k], k, out));
+    RETURN_IF_ERROR(AddCharacteristic(report.characteristics[k], k, report.sections, out));
   return out;
 }
 
@@ -250,6 +259,10 @@ void AddCharacteristics(pugi::xml_node doc, const std::vector<QifCharacteristic>
     Text(nom, "CharacteristicDefinitionId", std::to_string(id));
     Text(nom, "Name", c.name);
     if (std::isfinite(c.target)) Text(nom, "TargetValue", Num(c.target));
+    if (c.plane_normal.allFinite())  // after the base type's elements (Characteristics.xsd)
+      Text(nom, "Vector",
+           absl::StrCat(Num(c.plane_normal.x()), " ", Num(c.plane_normal.y()), " ",
+                        Num(c.plane_normal.z())));
     pugi::xml_node item = WithId(items, (c.kind + "CharacteristicItem").c_str(), id + 2);
     Text(item, "Name", c.name);
     pugi::xml_node designator = item.append_child("CharacteristicDesignator");

@@ -9,8 +9,10 @@
 //     ActualComponent: this part, SerialNumber = the part id.
 //   - MeasurementResources/MeasurementDevice: the cell (Name) and its sensor
 //     (Description).
-//   - Characteristics in report order: the surface, every region and
-//     every section as a SurfaceProfileCharacteristic, every comparison
+//   - Characteristics in report order: the surface and every region as a
+//     SurfaceProfileCharacteristic, every section as a
+//     LineProfileCharacteristic whose nominal's Vector is its plane's normal
+//     (a SurfaceProfile when the report lacks its "sections" entry), every comparison
 //     point as a PointProfileCharacteristic (the QIF type whose Value is a
 //     signed deviation at one location); a hole as two, a
 //     DiameterCharacteristic and a PositionCharacteristic named "<name>

@@ -23,10 +23,14 @@ import xml.etree.ElementTree as ET
 NS = {"q": "http://qifstandards.org/xsd/qif3"}
 
 
-def expected_measurements(c):
-    """The QIF characteristics of one report characteristic: (kind, name, value, band)."""
+def expected_measurements(c, planes):
+    """The QIF characteristics of one report characteristic: (kind, name, value, band).
+    `planes`: the names of the report's sections (a section with its plane
+    is a line profile)."""
     if c["type"] not in ("hole", "slot"):
         kind = "PointProfile" if c["type"] in ("point", "edge_point") else "SurfaceProfile"
+        if c["type"] == "section" and c["name"] in planes:
+            kind = "LineProfile"
         return [(kind, c["name"], None, None)]
     size = "width" if c["type"] == "slot" else "diameter"
     out = [(size.capitalize(), c["name"] + " " + size, c.get("measured_%s_mm" % size),
@@ -68,7 +72,8 @@ def check_against_report(qif_path, report):
     assert chars, qif_path
     for c in chars:
         statuses = []
-        for kind, name, value, band in expected_measurements(c):
+        for kind, name, value, band in expected_measurements(
+                c, {s["name"] for s in report.get("sections", [])}):
             m = next(measurements)
             assert m.tag == "{%s}%sCharacteristicMeasurement" % (NS["q"], kind), (m.tag, name)
             item = by_id[m.find("q:CharacteristicItemId", NS).text]

@@ -74,6 +74,17 @@ json HoleReport() {
   return r;
 }
 
+// The surface and a section across x, with its plane in "sections".
+json SectionReport() {
+  json r = Report();
+  r["characteristics"] = {r["characteristics"][0],
+                          Characteristic("X0", "section", "pass", -0.2, 0.2, 80, -0.05, 0.07)};
+  r["sections"] = json::parse(R"([{"name": "X0", "point_mm": [12, 0, 0], "normal": [0, 0.6, 0.8],
+      "tolerance_mm": {"lower": -0.2, "upper": 0.2}, "polylines": [{"xyz_mm": [12, -5, 0, 12, 5, 0]}],
+      "whiskers": {"at_mm": [], "direction": [], "deviation_mm": []}}])");
+  return r;
+}
+
 // The QIF of a report.json text, as a part's files are made: parsed, then mapped.
 absl::StatusOr<std::string> XmlOf(const std::string& report_json, const QifContext& context) {
   ASSIGN_OR_RETURN(InspectionReport report, ParseReport(report_json));
@@ -220,6 +231,29 @@ TEST(QifResults, HolesAreDiameterAndPositionSlotsWidthLengthAndPosition) {
   }
 }
 
+// A section is a line profile whose nominal names the plane's normal; one
+// whose plane the report does not carry stays a surface profile.
+TEST(QifResults, ASectionIsALineProfileInItsPlane) {
+  json report = SectionReport();
+  auto xml = XmlOf(report.dump(), Context());
+  ASSERT_TRUE(xml.ok()) << xml.status();
+  pugi::xml_document doc;
+  ASSERT_TRUE(doc.load_string(xml->c_str()));
+  const pugi::xml_node nominal = doc.find_node(
+      [](pugi::xml_node n) { return std::string(n.name()) == "LineProfileCharacteristicNominal"; });
+  ASSERT_TRUE(nominal) << *xml;
+  EXPECT_STREQ(nominal.child_value("Name"), "X0");
+  EXPECT_STREQ(nominal.child_value("Vector"), "0 0.6 0.8");
+  EXPECT_NE(xml->find("<LineProfileCharacteristicMeasurement"), std::string::npos);
+  EXPECT_NE(xml->find("<LineProfileCharacteristicDefinition"), std::string::npos);
+  report.erase("sections");
+  auto without = XmlOf(report.dump(), Context());
+  ASSERT_TRUE(without.ok());
+  EXPECT_EQ(without->find("LineProfile"), std::string::npos);
+  EXPECT_NE(without->find("<SurfaceProfileCharacteristicNominal id=\"15\""), std::string::npos)
+      << "X0, the second characteristic (ids 14..17), as a surface profile";
+}
+
 TEST(QifResults, AHoleWithoutItsZoneIsNamed) {
   json r = HoleReport();
   r["characteristics"][1].erase("position_tolerance_mm");
@@ -275,7 +309,7 @@ TEST(QifResults, ValidatesAgainstTheQif3Schema) {
   json only_surface = Report();
   only_surface["characteristics"] = {only_surface["characteristics"][0]};
   only_surface["verdict"] = "pass";
-  for (const json& report : {Report(), only_surface, HoleReport()}) {
+  for (const json& report : {Report(), only_surface, HoleReport(), SectionReport()}) {
     const std::string path = dir.path() + "/r.qif";
     ASSERT_TRUE(WriteQifResults(path, *ParseReport(report.dump()), Context()).ok());
     const std::string cmd =
