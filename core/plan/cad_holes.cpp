@@ -87,25 +87,37 @@ std::vector<std::vector<uint32_t>> RimLoops(const TriangleMesh& mesh) {
   return loops;
 }
 
-// Whether the wall below a rim loop faces the hole's axis (a hole) rather
-// than away from it (a boss): over the triangles at the loop's vertices
-// that stand across the axis, their normals' radial parts.
-bool WallFacesAxis(const TriangleMesh& mesh, const std::vector<uint32_t>& loop,
-                   const CadHole& hole) {
-  const std::set<uint32_t> on(loop.begin(), loop.end());
-  double inward = 0;
+// Whether the wall below each rim loop faces its hole's axis (a hole)
+// rather than away from it (a boss): over the triangles at the loop's
+// vertices that stand across the axis, their normals' radial parts. One
+// pass over the mesh for every loop (a vertex is on at most one rim loop).
+std::vector<bool> WallsFaceAxes(const TriangleMesh& mesh,
+                                const std::vector<std::vector<uint32_t>>& loops,
+                                const std::vector<CadHole>& holes) {
+  std::map<uint32_t, std::size_t> loop_of;  // vertex -> its loop
+  for (std::size_t k = 0; k < loops.size(); ++k)
+    for (uint32_t v : loops[k]) loop_of.emplace(v, k);
+  std::vector<double> inward(loops.size(), 0);
   for (const Triangle& t : mesh.triangles) {
-    if (!on.count(t[0]) && !on.count(t[1]) && !on.count(t[2])) continue;
+    std::set<std::size_t> touched;  // the loops this triangle has a vertex on
+    for (uint32_t v : t)
+      if (const auto it = loop_of.find(v); it != loop_of.end()) touched.insert(it->second);
+    if (touched.empty()) continue;
     const Eigen::Vector3d a = mesh.vertices[t[0]].cast<double>(),
                           b = mesh.vertices[t[1]].cast<double>(),
                           c = mesh.vertices[t[2]].cast<double>();
     const Eigen::Vector3d n = (b - a).cross(c - a).normalized();
-    if (!n.allFinite() || std::abs(n.dot(hole.axis)) > 0.5) continue;  // the face, not the wall
-    Eigen::Vector3d radial = (a + b + c) / 3 - hole.position_mm;
-    radial -= radial.dot(hole.axis) * hole.axis;
-    inward -= n.dot(radial.normalized());
+    for (std::size_t k : touched) {
+      const CadHole& hole = holes[k];
+      if (!n.allFinite() || std::abs(n.dot(hole.axis)) > 0.5) continue;  // the face, not the wall
+      Eigen::Vector3d radial = (a + b + c) / 3 - hole.position_mm;
+      radial -= radial.dot(hole.axis) * hole.axis;
+      inward[k] -= n.dot(radial.normalized());
+    }
   }
-  return inward > 0;
+  std::vector<bool> out;
+  for (double w : inward) out.push_back(w > 0);
+  return out;
 }
 
 // Per vertex, the sum of its triangles' area-weighted normals: over a
@@ -202,12 +214,17 @@ std::vector<CadHole> ListHoles(const TriangleMesh& mesh, const CadHoleSettings& 
   const std::vector<Eigen::Vector3d> sides = VertexSides(mesh);
   for (const auto& loop : loops)
     if (auto hole = HoleOfLoop(mesh, sides, loop, settings)) holes.push_back(*hole);
-  for (const auto& loop : rims) {
-    auto hole = HoleOfLoop(mesh, sides, loop, settings);
-    if (!hole || !WallFacesAxis(mesh, loop, *hole)) continue;
-    hole->rim = true;
-    holes.push_back(*hole);
-  }
+  std::vector<std::vector<uint32_t>> round;  // the rim loops that fit a circle or a slot
+  std::vector<CadHole> candidates;
+  for (const auto& loop : rims)
+    if (auto hole = HoleOfLoop(mesh, sides, loop, settings)) {
+      hole->rim = true;
+      round.push_back(loop);
+      candidates.push_back(*hole);
+    }
+  const std::vector<bool> hole_not_boss = WallsFaceAxes(mesh, round, candidates);
+  for (std::size_t k = 0; k < candidates.size(); ++k)
+    if (hole_not_boss[k]) holes.push_back(candidates[k]);
   std::sort(holes.begin(), holes.end(), [](const CadHole& a, const CadHole& b) {
     return std::lexicographical_compare(a.position_mm.data(), a.position_mm.data() + 3,
                                         b.position_mm.data(), b.position_mm.data() + 3);

@@ -52,5 +52,54 @@ TEST(CadHoles, APlaneFrameIsRightHandedAndFollowsTheSlot) {
   EXPECT_NEAR(std::abs(g.e1.dot(g.axis)), 0, 1e-12);
 }
 
+// A washer as a closed solid (outward normals): 48 segments, bore 8 mm,
+// outside 20 mm, 3 mm thick.
+TriangleMesh Washer() {
+  constexpr int n = 48;
+  constexpr double r_in = 4, r_out = 10, h = 3;
+  TriangleMesh m;
+  for (int i = 0; i < n; ++i) {
+    const double a = 2 * M_PI * i / n, c = std::cos(a), s = std::sin(a);
+    for (const auto& [r, z] : {std::pair{r_in, h}, {r_out, h}, {r_in, 0.0}, {r_out, 0.0}})
+      m.vertices.emplace_back(float(r * c), float(r * s), float(z));
+  }
+  // Per segment: inner top, outer top, inner bottom, outer bottom.
+  const auto it = [](int i) { return uint32_t(4 * (i % n)); };
+  const auto ot = [&](int i) { return it(i) + 1; };
+  const auto ib = [&](int i) { return it(i) + 2; };
+  const auto ob = [&](int i) { return it(i) + 3; };
+  for (int i = 0; i < n; ++i) {
+    const int j = i + 1;
+    m.triangles.push_back({it(i), ot(i), ot(j)});  // top, +z
+    m.triangles.push_back({it(i), ot(j), it(j)});
+    m.triangles.push_back({ib(i), ob(j), ob(i)});  // bottom, -z
+    m.triangles.push_back({ib(i), ib(j), ob(j)});
+    m.triangles.push_back({ob(i), ob(j), ot(j)});  // outside wall, away from the axis
+    m.triangles.push_back({ob(i), ot(j), ot(i)});
+    m.triangles.push_back({ib(i), it(j), ib(j)});  // bore wall, towards the axis
+    m.triangles.push_back({ib(i), it(i), it(j)});
+  }
+  return m;
+}
+
+// A closed solid has no boundary: its bore is found by its two rims, each
+// with the axis its face looks to; the outside rims are a boss's (the wall
+// faces away from the axis) and are not holes.
+TEST(CadHoles, ASolidsBoreIsListedAtBothRimsAndItsOutsideIsNot) {
+  const std::vector<CadHole> holes = ListHoles(Washer());
+  ASSERT_EQ(holes.size(), 2u);
+  for (const CadHole& h : holes) {
+    EXPECT_TRUE(h.rim);
+    EXPECT_FALSE(h.slot);
+    EXPECT_NEAR(h.diameter_mm, 8.0, 1e-5);
+    EXPECT_NEAR(h.position_mm.head<2>().norm(), 0.0, 1e-5);
+  }
+  // Sorted by position: the bottom rim (z = 0, looking down), then the top.
+  EXPECT_NEAR(holes[0].position_mm.z(), 0.0, 1e-6);
+  EXPECT_NEAR(holes[0].axis.z(), -1.0, 1e-9);
+  EXPECT_NEAR(holes[1].position_mm.z(), 3.0, 1e-6);
+  EXPECT_NEAR(holes[1].axis.z(), 1.0, 1e-9);
+}
+
 }  // namespace
 }  // namespace surfinspect
