@@ -3,8 +3,8 @@
 // two planted dents), its error map, then a plan of 20 regions and 50
 // comparison points (resolution and the one-pass characteristics), and
 // defect detection on the same map. Goal: the characteristics add at most
-// 15% to the error map. Then the drawing's plan (issue 40) on a pillar with
-// 20 holes: the holes, 10 sections and coverage, each timed through
+// 15% to the error map. Then a drawing's features on a pillar with 20
+// holes: the holes, 10 sections and coverage, each timed through
 // EvaluatePlan against the same plan without them; goal: together at most
 // 15% of the error map. Each step is timed best of 3, 2 threads.
 //

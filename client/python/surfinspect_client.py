@@ -316,6 +316,19 @@ def _vector3(values, where):
     return [_number({"v": v}, "v", where) for v in values]
 
 
+def _optional_numbers(entry, m, where, keys):
+    """Each of `keys` the plan entry gives, into the message field of that name."""
+    for key in keys:
+        if key in entry:
+            setattr(m, key, _number(entry, key, where))
+
+
+def _optional_band(entry, key, band_msg, where):
+    """The band `key` of the plan entry, when given, into `band_msg`."""
+    if key in entry:
+        _band(entry[key], band_msg, f"{where}.{key}")
+
+
 def _regions(plan, msg):
     for i, r in enumerate(plan.get("regions", [])):
         where = f"plan.regions[{i}]"
@@ -336,11 +349,8 @@ def _regions(plan, msg):
                     _number({"t": t}, "t", f"{where}.select.triangles[{k}]", True, 0, 2**32 - 1))
         elif "group" in s:
             m.select.group = str(s["group"])
-        if "tolerance_mm" in r:
-            _band(r["tolerance_mm"], m.tolerance_mm, where + ".tolerance_mm")
-        for key in ("allowed_fraction_outside", "min_coverage"):
-            if key in r:
-                setattr(m, key, _number(r, key, where))
+        _optional_band(r, "tolerance_mm", m.tolerance_mm, where)
+        _optional_numbers(r, m, where, ("allowed_fraction_outside", "min_coverage"))
 
 
 def _points(plan, msg):
@@ -352,11 +362,8 @@ def _points(plan, msg):
         for key in ("normal", "direction"):
             if key in p:
                 getattr(m, key).extend(_vector3(p[key], f"{where}.{key}"))
-        for key in ("radius_mm", "min_coverage"):
-            if key in p:
-                setattr(m, key, _number(p, key, where))
-        if "tolerance_mm" in p:
-            _band(p["tolerance_mm"], m.tolerance_mm, where + ".tolerance_mm")
+        _optional_numbers(p, m, where, ("radius_mm", "min_coverage"))
+        _optional_band(p, "tolerance_mm", m.tolerance_mm, where)
 
 
 def _sections(plan, msg):
@@ -366,11 +373,8 @@ def _sections(plan, msg):
         m = msg.sections.add(name=str(c.get("name", "")), region=str(c.get("region", "")))
         m.point_mm.extend(_vector3(c.get("point_mm"), where + ".point_mm"))
         m.normal.extend(_vector3(c.get("normal"), where + ".normal"))
-        for key in ("width_mm", "allowed_fraction_outside"):
-            if key in c:
-                setattr(m, key, _number(c, key, where))
-        if "tolerance_mm" in c:
-            _band(c["tolerance_mm"], m.tolerance_mm, where + ".tolerance_mm")
+        _optional_numbers(c, m, where, ("width_mm", "allowed_fraction_outside"))
+        _optional_band(c, "tolerance_mm", m.tolerance_mm, where)
 
 
 def _holes(plan, msg):
@@ -388,18 +392,12 @@ def _holes(plan, msg):
             m.position_mm.extend(_vector3(h.get("position_mm"), where + ".position_mm"))
             m.axis.extend(_vector3(h.get("axis"), where + ".axis"))
             m.diameter_mm = _number(h, size + "_mm", where)
-            for key in ("position_tolerance_mm", "min_arc_deg"):
-                if key in h:
-                    setattr(m, key, _number(h, key, where))
-            if size + "_tolerance_mm" in h:
-                _band(h[size + "_tolerance_mm"], m.diameter_tolerance_mm,
-                      f"{where}.{size}_tolerance_mm")
+            _optional_numbers(h, m, where, ("position_tolerance_mm", "min_arc_deg"))
+            _optional_band(h, size + "_tolerance_mm", m.diameter_tolerance_mm, where)
             if kind == "slot":
                 m.length_mm = _number(h, "length_mm", where)
                 m.direction.extend(_vector3(h.get("direction"), where + ".direction"))
-                if "length_tolerance_mm" in h:
-                    _band(h["length_tolerance_mm"], m.length_tolerance_mm,
-                          where + ".length_tolerance_mm")
+                _optional_band(h, "length_tolerance_mm", m.length_tolerance_mm, where)
 
 
 def _edge_points(plan, msg):
@@ -408,10 +406,8 @@ def _edge_points(plan, msg):
         _keys(e, "edge_point", where)
         m = msg.edge_points.add(name=str(e.get("name", "")))
         m.position_mm.extend(_vector3(e.get("position_mm"), where + ".position_mm"))
-        if "radius_mm" in e:
-            m.radius_mm = _number(e, "radius_mm", where)
-        if "tolerance_mm" in e:
-            _band(e["tolerance_mm"], m.tolerance_mm, where + ".tolerance_mm")
+        _optional_numbers(e, m, where, ("radius_mm",))
+        _optional_band(e, "tolerance_mm", m.tolerance_mm, where)
 
 
 def plan_proto(plan):

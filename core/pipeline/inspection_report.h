@@ -152,7 +152,7 @@ struct InspectionReport {
   ReportTiming timing;
   std::vector<ReportCharacteristic> characteristics;
   std::vector<ReportDefect> defects;
-  std::vector<ReportSection> sections;  // the plan's sections, in plan order; "sections"
+  std::vector<ReportSection> sections;     // the plan's sections, in plan order; "sections"
   std::optional<ReportCoverage> coverage;  // where the scan saw the CAD; "coverage"
   // Written by the CLI's errormap only.
   std::optional<ReportInputs> inputs;

@@ -12,11 +12,23 @@
 namespace surfinspect {
 namespace {
 
+// The runs of one in SortedEdgeUses' list: the edges used by one triangle.
+std::vector<EdgeUse> UsedOnce(const std::vector<EdgeUse>& uses) {
+  std::vector<EdgeUse> out;
+  for (std::size_t i = 0; i < uses.size(); ++i)
+    if ((i == 0 || uses[i - 1].edge != uses[i].edge) &&
+        (i + 1 == uses.size() || uses[i + 1].edge != uses[i].edge))
+      out.push_back(uses[i]);
+  return out;
+}
+
 // Boundary edges directed as their one triangle walks them, chained into
 // closed loops of vertex ids (a loop that does not close is dropped).
-std::vector<std::vector<uint32_t>> BoundaryLoops(const TriangleMesh& mesh) {
+// `uses` is SortedEdgeUses(mesh).
+std::vector<std::vector<uint32_t>> BoundaryLoops(const TriangleMesh& mesh,
+                                                 const std::vector<EdgeUse>& uses) {
   std::multimap<uint32_t, uint32_t> next;  // from -> to
-  for (const EdgeUse& use : BoundaryEdges(mesh)) {
+  for (const EdgeUse& use : UsedOnce(uses)) {
     const Triangle& t = mesh.triangles[use.triangle];
     const auto lo = static_cast<uint32_t>(use.edge >> 32);
     const auto hi = static_cast<uint32_t>(use.edge);
@@ -53,9 +65,9 @@ std::vector<std::vector<uint32_t>> BoundaryLoops(const TriangleMesh& mesh) {
 // such edges (a vertex where more meet, a box's corner, ends no hole rim).
 constexpr double kRimAngleDeg = 60;
 
-std::vector<std::vector<uint32_t>> RimLoops(const TriangleMesh& mesh) {
+std::vector<std::vector<uint32_t>> RimLoops(const TriangleMesh& mesh,
+                                            const std::vector<EdgeUse>& uses) {
   const std::vector<Eigen::Vector3f> normals = mesh.FaceNormals();
-  const std::vector<EdgeUse> uses = SortedEdgeUses(mesh);
   const float cos_max = static_cast<float>(std::cos(kRimAngleDeg * M_PI / 180));
   std::map<uint32_t, std::vector<uint32_t>> sharp;  // vertex -> its sharp edges' other ends
   for (std::size_t i = 0; i + 1 < uses.size(); ++i) {
@@ -208,8 +220,9 @@ PlaneFrame MakePlaneFrame(const Eigen::Vector3d& origin, const Eigen::Vector3d& 
 
 std::vector<CadHole> ListHoles(const TriangleMesh& mesh, const CadHoleSettings& settings) {
   std::vector<CadHole> holes;
-  const auto loops = BoundaryLoops(mesh);
-  const auto rims = RimLoops(mesh);
+  const std::vector<EdgeUse> uses = SortedEdgeUses(mesh);  // once, for both kinds of loop
+  const auto loops = BoundaryLoops(mesh, uses);
+  const auto rims = RimLoops(mesh, uses);
   if (loops.empty() && rims.empty()) return holes;
   const std::vector<Eigen::Vector3d> sides = VertexSides(mesh);
   for (const auto& loop : loops)
@@ -233,13 +246,7 @@ std::vector<CadHole> ListHoles(const TriangleMesh& mesh, const CadHoleSettings& 
 }
 
 std::vector<EdgeUse> BoundaryEdges(const TriangleMesh& mesh) {
-  const std::vector<EdgeUse> uses = SortedEdgeUses(mesh);
-  std::vector<EdgeUse> out;
-  for (std::size_t i = 0; i < uses.size(); ++i)
-    if ((i == 0 || uses[i - 1].edge != uses[i].edge) &&
-        (i + 1 == uses.size() || uses[i + 1].edge != uses[i].edge))
-      out.push_back(uses[i]);
-  return out;
+  return UsedOnce(SortedEdgeUses(mesh));
 }
 
 std::optional<CadEdge> NearestBoundaryEdge(const TriangleMesh& mesh, const Eigen::Vector3d& p) {
