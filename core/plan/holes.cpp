@@ -1,5 +1,7 @@
 #include "core/plan/holes.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -117,18 +119,21 @@ absl::StatusOr<std::vector<HoleMeasurement>> MeasureHoles(const std::vector<Plan
                                                           const std::vector<RayView>* prepared) {
   const std::vector<RayView> own = prepared ? std::vector<RayView>{} : PrepareRayViews(views);
   const std::vector<RayView>& rays = prepared ? *prepared : own;
-  std::vector<HoleMeasurement> out;
-  for (const PlanHole& hole : holes) {
-    if (IsCancelled(cancel)) return absl::CancelledError("holes cancelled");
-    if (rays.empty()) {
-      out.push_back(NotMeasured(views.empty() ? "no organized views (holes are measured by inspect)"
-                                              : "no view has a pinhole's organized grid",
-                                EdgeSamples{}));
-      continue;
-    }
-    const EdgeContour c = ContourOf(hole, settings.band_mm + settings.annulus_mm);
-    out.push_back(Judge(hole, c.frame, SampleEdge(rays, c, settings)));
-  }
+  if (rays.empty())
+    return std::vector<HoleMeasurement>(
+        holes.size(),
+        NotMeasured(views.empty() ? "no organized views (holes are measured by inspect)"
+                                  : "no view has a pinhole's organized grid",
+                    EdgeSamples{}));
+  // Each hole reads its own window of pixels: in parallel (the caller's
+  // arena), each result in its slot.
+  std::vector<HoleMeasurement> out(holes.size());
+  tbb::parallel_for(std::size_t{0}, holes.size(), [&](std::size_t i) {
+    if (IsCancelled(cancel)) return;
+    const EdgeContour c = ContourOf(holes[i], settings.band_mm + settings.annulus_mm);
+    out[i] = Judge(holes[i], c.frame, SampleEdge(rays, c, settings));
+  });
+  if (IsCancelled(cancel)) return absl::CancelledError("holes cancelled");
   return out;
 }
 

@@ -1,5 +1,6 @@
 #include "core/plan/plan_evaluation.h"
 
+#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <optional>
@@ -51,13 +52,25 @@ absl::StatusOr<InspectionPlan> ParsePlanForMeshFile(
 
 namespace {
 
-// Each section of the plan cut on the map, limited to its region's triangles.
+// f() run in `arena` (its threads), its result returned.
+template <typename F>
+auto InArena(tbb::task_arena& arena, F&& f) {
+  decltype(f()) result;
+  arena.execute([&] { result = f(); });
+  return result;
+}
+
+// Each section of the plan cut on the map, limited to its region's
+// triangles; the sections in parallel (the caller's arena), each in its
+// slot, the first failure in plan order returned.
 absl::StatusOr<std::vector<SectionCut>> CutSections(const ErrorMapResult& em,
                                                     const TriangleMesh& part,
                                                     const ResolvedInspectionPlan& rp,
                                                     const TrianglePoints* by_triangle) {
-  std::vector<SectionCut> out;
-  for (const PlanSection& s : rp.plan.sections) {
+  const std::vector<PlanSection>& sections = rp.plan.sections;
+  std::vector<absl::StatusOr<SectionCut>> cuts(sections.size());
+  tbb::parallel_for(std::size_t{0}, sections.size(), [&](std::size_t i) {
+    const PlanSection& s = sections[i];
     std::vector<uint8_t> mask;
     for (std::size_t r = 0; r < rp.plan.regions.size() && !s.region.empty(); ++r) {
       if (rp.plan.regions[r].name != s.region) continue;
@@ -66,9 +79,13 @@ absl::StatusOr<std::vector<SectionCut>> CutSections(const ErrorMapResult& em,
         for (uint32_t k = rp.region_offsets[t]; k < rp.region_offsets[t + 1]; ++k)
           mask[t] |= rp.region_ids[k] == r;
     }
-    ASSIGN_OR_RETURN(auto cut, CutSection(part, em, {s.point_mm, s.normal, s.width_mm}, mask,
-                                          kDefaultMaxWhiskers, by_triangle));
-    out.push_back(std::move(cut));
+    cuts[i] = CutSection(part, em, {s.point_mm, s.normal, s.width_mm}, mask, kDefaultMaxWhiskers,
+                         by_triangle);
+  });
+  std::vector<SectionCut> out;
+  for (auto& cut : cuts) {
+    if (!cut.ok()) return cut.status();
+    out.push_back(std::move(*cut));
   }
   return out;
 }
@@ -89,17 +106,16 @@ absl::StatusOr<PlanOutcome> EvaluatePlan(const ErrorMapResult& error_map, const 
                                          const std::vector<PlanView>& views) {
   ASSIGN_OR_RETURN(auto resolved, ResolveInspectionPlan(plan, part));
   PlanOutcome out;
+  tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
   // The sampling spacing, estimated once for coverage and defects alike.
   const bool coverage = PlanJudgesCoverage(plan);
   const double spacing = coverage || plan.defects ? EstimateSurfaceSpacing(error_map, cloud) : 0.0;
   // The points by triangle, once for coverage and sections.
   std::optional<TrianglePoints> by_triangle;
   if (coverage || !plan.sections.empty()) {
-    tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
-    absl::StatusOr<TrianglePoints> grouped;
-    arena.execute([&] { grouped = PointsByTriangle(error_map, part.num_triangles()); });
-    if (!grouped.ok()) return grouped.status();
-    by_triangle = std::move(*grouped);
+    ASSIGN_OR_RETURN(by_triangle, InArena(arena, [&] {
+                       return PointsByTriangle(error_map, part.num_triangles());
+                     }));
   }
   const TrianglePoints* grouped = by_triangle ? &*by_triangle : nullptr;
   if (coverage) {
@@ -119,15 +135,18 @@ absl::StatusOr<PlanOutcome> EvaluatePlan(const ErrorMapResult& error_map, const 
                      FindDefects(error_map, cloud, part, *plan.defects, &resolved, ds));
     out.defects_run = true;
   }
-  ASSIGN_OR_RETURN(out.sections, CutSections(error_map, part, resolved, grouped));
+  ASSIGN_OR_RETURN(out.sections,
+                   InArena(arena, [&] { return CutSections(error_map, part, resolved, grouped); }));
   if (coverage)  // a section's curve is judged like an area
     for (SectionCut& cut : out.sections)
       cut.coverage = SectionCoverage(cut, error_map, out.coverage.distance_mm);
   // The views' pixel rays, fitted once for holes and edge points.
   const std::vector<RayView> rays = plan.holes.empty() && plan.edge_points.empty()
                                         ? std::vector<RayView>{}
-                                        : PrepareRayViews(views);
-  ASSIGN_OR_RETURN(auto holes, MeasureHoles(resolved.plan.holes, views, {}, cancel, &rays));
+                                        : InArena(arena, [&] { return PrepareRayViews(views); });
+  ASSIGN_OR_RETURN(auto holes, InArena(arena, [&] {
+                     return MeasureHoles(resolved.plan.holes, views, {}, cancel, &rays);
+                   }));
   ASSIGN_OR_RETURN(auto edges,
                    MeasureEdgePoints(resolved.plan.edge_points, part, views, {}, cancel, &rays));
   CharacteristicsSettings cs;

@@ -102,20 +102,26 @@ std::vector<uint32_t> SlabPoints(const TriangleMesh& part, const ErrorMapResult&
                                  const SectionPlane& plane, const std::vector<uint8_t>& triangles,
                                  const TrianglePoints* by_triangle) {
   std::vector<uint32_t> out;
-  const auto consider = [&](std::size_t i) {
-    const uint32_t t = em.triangle_id[i];
-    if (t == UINT32_MAX || (!triangles.empty() && !triangles[t])) return;
+  const auto in_slab = [&](std::size_t i) {
     const double off = (em.closest_point[i].cast<double>() - plane.point_mm).dot(plane.normal);
-    if (std::abs(off) <= plane.width_mm / 2) out.push_back(static_cast<uint32_t>(i));
+    return std::abs(off) <= plane.width_mm / 2;
   };
+  const auto selected = [&](uint32_t t) { return triangles.empty() || triangles[t]; };
   if (!by_triangle) {
-    for (std::size_t i = 0; i < em.triangle_id.size(); ++i) consider(i);
+    for (std::size_t i = 0; i < em.triangle_id.size(); ++i) {
+      const uint32_t t = em.triangle_id[i];
+      if (t != UINT32_MAX && selected(t) && in_slab(i)) out.push_back(static_cast<uint32_t>(i));
+    }
     return out;
   }
   for (uint32_t t = 0; t < part.num_triangles(); ++t)
-    if ((triangles.empty() || triangles[t]) && NearSlab(part, t, plane))
-      for (uint32_t k = by_triangle->begin(t); k < by_triangle->end(t); ++k)
-        consider(by_triangle->points[k]);
+    if (selected(t) && NearSlab(part, t, plane))
+      for (uint32_t k = by_triangle->begin(t); k < by_triangle->end(t); ++k) {
+        // Runs of scan rows far apart: fetched ahead, the loads overlap.
+        if (k + 16 < by_triangle->end(t))
+          __builtin_prefetch(&em.closest_point[by_triangle->points[k + 16]]);
+        if (in_slab(by_triangle->points[k])) out.push_back(by_triangle->points[k]);
+      }
   std::sort(out.begin(), out.end());
   return out;
 }
