@@ -37,21 +37,40 @@ absl::StatusOr<InspectionResult> InspectPart(const MeshIndex& part,
     for (std::size_t k = 0; k < views.size(); ++k)
       progress(InspectionStage::kViewRegistered, views[k].name, out.merged.points_per_view[k]);
   if (IsCancelled(cancel)) return absl::CancelledError("inspect cancelled");
-  auto map =
-      ComputeErrorMap(part, out.merged.cloud_in_world, world_from_part, settings.error_map, cancel);
-  if (!map.ok()) return map.status();
-  out.error_map = *std::move(map);
+  const InspectionPlan plan = settings.plan ? *settings.plan : PlanFromSettings(settings.error_map);
+  ASSIGN_OR_RETURN(out.error_map, ComputeErrorMap(part, out.merged.cloud_in_world, world_from_part,
+                                                  settings.error_map, cancel));
   // The views as the plan measures holes and edges on them: filtered, in the
   // part frame.
   std::vector<PlanView> plan_views;
-  if (settings.plan && (!settings.plan->holes.empty() || !settings.plan->edge_points.empty()))
-    for (const ViewScan& v : views)
+  const bool edges = !plan.holes.empty() || !plan.edge_points.empty() ||
+                     plan.alignment.mode == AlignmentMode::kRps;
+  for (const ViewScan& v : views)
+    if (edges)
       plan_views.push_back(
           {v.name, &v.cloud_in_sensor, world_from_part.inverse() * v.world_from_sensor});
-  ASSIGN_OR_RETURN(
-      out.plan, EvaluatePlan(out.error_map, out.merged.cloud_in_world, part.mesh(),
-                             settings.plan ? *settings.plan : PlanFromSettings(settings.error_map),
-                             settings.error_map.threads, cancel, plan_views));
+  // The plan's alignment, measured in the calibrated frame; with a
+  // correction the scan is mapped again in the aligned frame and judged
+  // there.
+  AlignmentInputs aligning{part,
+                           out.error_map,
+                           out.merged.cloud_in_world,
+                           world_from_part,
+                           plan_views,
+                           settings.error_map.threads};
+  ASSIGN_OR_RETURN(AlignmentOutcome alignment, MeasureAlignment(aligning, plan, cancel));
+  if (alignment.aligned) {
+    const Eigen::Isometry3d aligned = world_from_part * alignment.correction.inverse();
+    ASSIGN_OR_RETURN(out.error_map, ComputeErrorMap(part, out.merged.cloud_in_world, aligned,
+                                                    settings.error_map, cancel));
+    for (PlanView& v : plan_views) v.part_from_sensor = alignment.correction * v.part_from_sensor;
+  }
+  InspectionPlan judged = plan;  // aligned here, so judged as it now stands
+  judged.alignment = PlanAlignment{};
+  ASSIGN_OR_RETURN(out.plan, EvaluatePlan(out.error_map, out.merged.cloud_in_world, part.mesh(),
+                                          judged, settings.error_map.threads, cancel, plan_views));
+  ApplyAlignmentVerdict(alignment, &out.plan.characteristics);
+  out.plan.alignment = std::move(alignment);
   if (progress) progress(InspectionStage::kErrorMap, "", out.error_map.stats.matched);
   return out;
 }

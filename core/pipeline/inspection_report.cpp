@@ -224,6 +224,7 @@ void VisitReport(V& v, R& r) {
   }
   VisitReportSections(v, r.sections);
   VisitReportCoverage(v, r.coverage);
+  VisitReportAlignment(v, r.alignment);
   v.Object("inputs", r.inputs, SURFINSPECT_VISIT(VisitInputs));
   v.Object("mesh", r.mesh, SURFINSPECT_VISIT(VisitMesh));
   v.Object("cad", r.cad, SURFINSPECT_VISIT(VisitCad));
@@ -270,6 +271,7 @@ absl::StatusOr<InspectionReport> DecodeReport(const json& j) {
   if (!r.status().ok()) return r.status();
   if (absl::Status s = CheckReportSections(report.sections); !s.ok()) return s;
   if (absl::Status s = CheckReportCoverage(report.coverage); !s.ok()) return s;
+  if (absl::Status s = CheckReportAlignment(report.alignment); !s.ok()) return s;
   return report;
 }
 
@@ -352,6 +354,7 @@ InspectionReport MakeInspectionReport(const ErrorMapResult& error_map,
   for (const Defect& d : outcome.defects.defects) out.defects.push_back(ReportDefectOf(d));
   out.sections = ReportSectionsOf(outcome);
   out.coverage = ReportCoverageOf(outcome);
+  out.alignment = ReportAlignmentOf(outcome);
   return out;
 }
 

@@ -21,6 +21,7 @@
 #include "absl/status/statusor.h"
 #include "core/cad/cad_report.h"
 #include "core/errormap/error_map.h"
+#include "core/pipeline/report_alignment.h"
 #include "core/pipeline/report_coverage.h"
 #include "core/pipeline/report_section.h"
 #include "core/plan/characteristics.h"
@@ -152,8 +153,9 @@ struct InspectionReport {
   ReportTiming timing;
   std::vector<ReportCharacteristic> characteristics;
   std::vector<ReportDefect> defects;
-  std::vector<ReportSection> sections;     // the plan's sections, in plan order; "sections"
-  std::optional<ReportCoverage> coverage;  // where the scan saw the CAD; "coverage"
+  std::vector<ReportSection> sections;       // the plan's sections, in plan order; "sections"
+  std::optional<ReportCoverage> coverage;    // where the scan saw the CAD; "coverage"
+  std::optional<ReportAlignment> alignment;  // how the scan was aligned; "alignment"
   // Written by the CLI's errormap only.
   std::optional<ReportInputs> inputs;
   std::optional<ReportMesh> mesh;

@@ -8,18 +8,15 @@
 #include "absl/strings/str_format.h"
 #include "core/distance/point_triangle.h"
 #include "core/plan/cad_holes.h"
+#include "core/plan/plan_alignment.h"
+#include "core/plan/plan_json_read.h"
 #include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
 
-absl::Status Bad(const std::string& path, absl::string_view what) {
-  return absl::InvalidArgumentError(absl::StrCat(path, ": ", what));
-}
-
-std::string Index(const std::string& path, std::size_t i) {
-  return absl::StrCat(path, "[", i, "]");
-}
+using plan_json::Bad;
+using plan_json::Index;
 
 // ---- validation of the struct --------------------------------------------
 
@@ -269,6 +266,7 @@ absl::Status ValidateInspectionPlan(const InspectionPlan& plan, const TriangleMe
   RETURN_IF_ERROR(CheckSections(plan, part, where, names));
   RETURN_IF_ERROR(CheckHoles(plan, part, where, names));
   RETURN_IF_ERROR(CheckEdgePoints(plan, part, where, names));
+  RETURN_IF_ERROR(ValidatePlanAlignment(plan, part, where + ".alignment"));
   if (plan.defects) {
     const std::string path = where + ".defects";
     const DefectRules& d = *plan.defects;

@@ -27,6 +27,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "core/plan/cad_holes.h"
+#include "core/registration/rigid_dofs.h"
 #include "core/types/mesh_groups.h"
 #include "core/types/triangle_mesh.h"
 
@@ -139,6 +140,39 @@ struct DefectRules {
   std::optional<int> max_count;
 };
 
+// How the scan is aligned to the CAD before anything is judged
+// (core/plan/alignment.h, docs/alignment.md). `calibrated`: the cell's
+// calibrated transforms alone (the paper's, §II); `rps`: the drawing's
+// reference points, each locking some directions; `best_fit`: a robust
+// point-to-plane fit with locked degrees of freedom, optionally on some
+// regions. The correction is a result; beyond its allowed size the part
+// fails.
+enum class AlignmentMode { kCalibrated, kRps, kBestFit };
+// "calibrated" | "rps" | "best_fit".
+const char* AlignmentModeName(AlignmentMode mode);
+
+// An RPS reference: a plan hole (a hole locks the two directions of its
+// plane, a slot the one across its length) or a surface point (locks the
+// CAD normal there; measured as the median deviation of the points whose
+// closest CAD point lies within radius_mm of it).
+struct AlignmentReference {
+  std::string name;
+  std::string hole;                                       // a plan hole's or slot's name, or "":
+  Eigen::Vector3d position_mm = Eigen::Vector3d::Zero();  // a surface point, part frame
+  double radius_mm = 3.0;                                 // > 0
+};
+
+struct PlanAlignment {
+  AlignmentMode mode = AlignmentMode::kCalibrated;
+  std::vector<AlignmentReference> references;  // rps: locking all six degrees of freedom
+  std::vector<std::string> regions;            // best_fit: fitted on these; empty = the part
+  LockedDofs locked;                           // best_fit: held at zero
+  // The allowed correction: the largest displacement of a reference (of a
+  // used point, for best_fit), mm, and the rotation angle, degrees; > 0.
+  double max_correction_mm = 2.0;
+  double max_correction_deg = 1.0;
+};
+
 // A plan's default least coverage: a characteristic whose CAD area was seen
 // over less is not measured. docs/inspection-plan.md gives the reasons.
 inline constexpr double kDefaultMinCoverage = 0.9;
@@ -161,6 +195,7 @@ struct InspectionPlan {
   std::vector<PlanHole> holes;  // holes, then slots, in plan order
   std::vector<PlanEdgePoint> edge_points;
   std::optional<DefectRules> defects;  // unset: no defect detection
+  PlanAlignment alignment;
 };
 
 // Checks the plan against the part it will be applied to: finite numbers,

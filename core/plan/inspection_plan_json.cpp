@@ -7,69 +7,15 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/plan/inspection_plan.h"
+#include "core/plan/plan_alignment.h"
+#include "core/plan/plan_json_read.h"
 #include "core/types/status_macros.h"
 
 namespace surfinspect {
 namespace {
 
 using nlohmann::json;
-
-absl::Status Bad(const std::string& path, absl::string_view what) {
-  return absl::InvalidArgumentError(absl::StrCat(path, ": ", what));
-}
-
-std::string Index(const std::string& path, std::size_t i) {
-  return absl::StrCat(path, "[", i, "]");
-}
-
-// ---- JSON reading ----------------------------------------------------------
-
-absl::Status CheckKeys(const json& j, const std::string& path,
-                       std::initializer_list<const char*> allowed) {
-  if (!j.is_object()) return Bad(path, "must be an object");
-  for (const auto& [key, value] : j.items()) {
-    bool known = false;
-    for (const char* a : allowed) known = known || key == a;
-    if (!known) return Bad(absl::StrCat(path, ".", key), "unknown key");
-  }
-  return absl::OkStatus();
-}
-
-absl::StatusOr<double> Number(const json& j, const std::string& path) {
-  if (!j.is_number()) return Bad(path, "must be a number");
-  const double v = j.get<double>();
-  if (!std::isfinite(v)) return Bad(path, "not a finite number");
-  return v;
-}
-
-absl::StatusOr<Eigen::Vector3d> Vector3(const json& j, const std::string& path) {
-  if (!j.is_array() || j.size() != 3) return Bad(path, "must be an array of 3 numbers");
-  Eigen::Vector3d v;
-  for (int a = 0; a < 3; ++a) {
-    ASSIGN_OR_RETURN(auto x, Number(j[a], Index(path, a)));
-    v[a] = x;
-  }
-  return v;
-}
-
-absl::StatusOr<std::string> String(const json& j, const std::string& path) {
-  if (!j.is_string()) return Bad(path, "must be a string");
-  return j.get<std::string>();
-}
-
-absl::StatusOr<bool> Bool(const json& j, const std::string& path) {
-  if (!j.is_boolean()) return Bad(path, "must be true or false");
-  return j.get<bool>();
-}
-
-// An optional number: `out` is set when `key` is present.
-template <typename T>
-absl::Status OptionalNumber(const json& j, const char* key, const std::string& path, T& out) {
-  if (!j.contains(key)) return absl::OkStatus();
-  ASSIGN_OR_RETURN(auto v, Number(j[key], absl::StrCat(path, ".", key)));
-  out = v;
-  return absl::OkStatus();
-}
+using namespace plan_json;  // NOLINT: the plan's JSON reading helpers
 
 absl::StatusOr<ToleranceBand> Band(const json& j, const std::string& path) {
   if (auto st = CheckKeys(j, path, {"lower", "upper"}); !st.ok()) return st;
@@ -199,12 +145,6 @@ absl::StatusOr<PlanSection> Section(const json& j, const std::string& path) {
   return s;
 }
 
-absl::StatusOr<Eigen::Vector3d> UnitVector(const json& j, const std::string& path) {
-  ASSIGN_OR_RETURN(auto v, Vector3(j, path));
-  if (!(v.norm() > 1e-12)) return Bad(path, "zero vector");
-  return Eigen::Vector3d(v.normalized());
-}
-
 // The keys a hole and a slot share; `size` is "diameter" or "width".
 absl::Status HoleCommon(const json& j, const std::string& path, const char* size, PlanHole& h) {
   const std::string size_key = absl::StrCat(size, "_mm"),
@@ -286,16 +226,6 @@ absl::StatusOr<DefectRules> Defects(const json& j, const std::string& path) {
   return d;
 }
 
-template <typename T, typename F>
-absl::Status List(const json& j, const std::string& path, F parse, std::vector<T>& out) {
-  if (!j.is_array()) return Bad(path, "must be an array");
-  for (std::size_t i = 0; i < j.size(); ++i) {
-    ASSIGN_OR_RETURN(auto item, parse(j[i], Index(path, i)));
-    out.push_back(std::move(item));
-  }
-  return absl::OkStatus();
-}
-
 }  // namespace
 
 absl::StatusOr<InspectionPlan> ParseInspectionPlan(const json& j, const TriangleMesh& part,
@@ -304,7 +234,7 @@ absl::StatusOr<InspectionPlan> ParseInspectionPlan(const json& j, const Triangle
   if (auto st = CheckKeys(j, where,
                           {"schema", "tolerance_mm", "allowed_fraction_outside", "min_coverage",
                            "coverage_distance_mm", "allow_not_measured", "regions", "points",
-                           "sections", "holes", "slots", "edge_points", "defects"});
+                           "sections", "holes", "slots", "edge_points", "defects", "alignment"});
       !st.ok())
     return st;
   InspectionPlan plan;
@@ -343,6 +273,9 @@ absl::StatusOr<InspectionPlan> ParseInspectionPlan(const json& j, const Triangle
   if (j.contains("defects")) {
     ASSIGN_OR_RETURN(auto d, Defects(j["defects"], where + ".defects"));
     plan.defects = d;
+  }
+  if (j.contains("alignment")) {
+    ASSIGN_OR_RETURN(plan.alignment, ParsePlanAlignment(j["alignment"], where + ".alignment"));
   }
   RETURN_IF_ERROR(ValidateInspectionPlan(plan, part, groups, where));
   return plan;

@@ -155,6 +155,13 @@ absl::StatusOr<PlanOutcome> EvaluatePlan(const ErrorMapResult& error_map, const 
                    ComputeCharacteristics(error_map, resolved, out.defects.defects.size(), cs,
                                           out.coverage_run ? &out.coverage : nullptr, out.sections,
                                           holes, edges));
+  if (plan.alignment.mode != AlignmentMode::kCalibrated) {
+    // The error map is given: nothing here can map the scan again.
+    out.alignment.mode = plan.alignment.mode;
+    out.alignment.failure =
+        "the error map alone cannot be aligned again; inspect aligns the part from its views";
+    ApplyAlignmentVerdict(out.alignment, &out.characteristics);
+  }
   return out;
 }
 

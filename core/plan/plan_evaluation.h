@@ -18,6 +18,7 @@
 #include "absl/status/statusor.h"
 #include "core/errormap/error_map.h"
 #include "core/io/length_units.h"
+#include "core/plan/alignment.h"
 #include "core/plan/characteristics.h"
 #include "core/plan/defects.h"
 #include "core/plan/holes.h"
@@ -66,6 +67,7 @@ struct PlanOutcome {
   CoverageResult coverage;                // of the same characteristics, when run
   bool defects_run = false;               // the plan has defect rules
   DefectsResult defects;                  // empty unless defects_run
+  AlignmentOutcome alignment;             // how the scan was aligned (calibrated: nothing done)
   bool pass() const { return characteristics.pass; }
 };
 

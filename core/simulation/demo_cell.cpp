@@ -151,11 +151,11 @@ absl::StatusOr<SimulatedScan> SimulateDemoPartScan(const DemoCell& cell, const D
   ScanOptions opt = scan;
   opt.defects.insert(opt.defects.end(), part.defects.begin(), part.defects.end());
   opt.seed = scan.seed * 7919 + part.number * 100 + v;
+  const Eigen::Isometry3d placed = cell.world_from_part * part.in_fixture;
   if (!part.manufactured)
-    return SimulateScan(cell.part, cell.world_from_part, vp.world_from_sensor, cell.intrinsics,
-                        opt);
+    return SimulateScan(cell.part, placed, vp.world_from_sensor, cell.intrinsics, opt);
   const TriangleMesh made = MakePillarMesh(cell.part_length_mm, *part.manufactured);
-  return SimulateScan(made, cell.world_from_part, vp.world_from_sensor, cell.intrinsics, opt);
+  return SimulateScan(made, placed, vp.world_from_sensor, cell.intrinsics, opt);
 }
 
 }  // namespace surfinspect

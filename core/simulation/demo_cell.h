@@ -64,6 +64,11 @@ struct DemoPart {
   // The part as made where it differs from the CAD (shifted or resized
   // holes, an offset trim edge); unset: as the CAD.
   std::optional<PillarFeatures> manufactured;
+  // Where the part sits in its fixture, off where the CAD says (clamps,
+  // pins, spring-back): its points p lie at world_from_part * in_fixture * p.
+  // The calibrated cell sees it displaced; an RPS or best-fit alignment
+  // recovers in_fixture^-1 (core/plan/alignment.h).
+  Eigen::Isometry3d in_fixture = Eigen::Isometry3d::Identity();
 };
 
 // Parts 1..count with their defects, drawn from `scan_seed` (the seed of the

@@ -4,12 +4,10 @@
 
 namespace surfinspect::testing {
 
-ScannedPart ScanMadePart(const DemoCell& cell, const PillarFeatures& made, uint64_t seed,
-                         const std::vector<std::size_t>& which,
-                         const LinkClusteringSettings& filter) {
-  DemoPart part;
-  part.number = int(seed);
-  part.manufactured = made;
+namespace {
+
+ScannedPart Scan(const DemoCell& cell, const DemoPart& part, uint64_t seed,
+                 const std::vector<std::size_t>& which, const LinkClusteringSettings& filter) {
   ScanOptions opt;
   opt.noise_sigma_mm = 0.015;
   opt.seed = seed;
@@ -29,6 +27,21 @@ ScannedPart ScanMadePart(const DemoCell& cell, const PillarFeatures& made, uint6
     s.plan_views.push_back(
         {v.name, &v.cloud_in_sensor, cell.world_from_part.inverse() * v.world_from_sensor});
   return s;
+}
+
+}  // namespace
+
+ScannedPart ScanMadePart(const DemoCell& cell, const PillarFeatures& made, uint64_t seed,
+                         const std::vector<std::size_t>& which,
+                         const LinkClusteringSettings& filter) {
+  DemoPart part;
+  part.number = int(seed);
+  part.manufactured = made;
+  return Scan(cell, part, seed, which, filter);
+}
+
+ScannedPart ScanDemoPart(const DemoCell& cell, const DemoPart& part, uint64_t seed) {
+  return Scan(cell, part, seed, {}, LinkClusteringSettings::ForInspection());
 }
 
 }  // namespace surfinspect::testing

@@ -26,4 +26,8 @@ ScannedPart ScanMadePart(
     const std::vector<std::size_t>& which = {},
     const LinkClusteringSettings& filter = LinkClusteringSettings::ForInspection());
 
+// Any demo part (displaced in its fixture, with defects), scanned and
+// filtered likewise from all the cell's viewpoints.
+ScannedPart ScanDemoPart(const DemoCell& cell, const DemoPart& part, uint64_t seed);
+
 }  // namespace surfinspect::testing
