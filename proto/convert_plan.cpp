@@ -1,5 +1,6 @@
 // proto/convert.h: the inspection plan.
 #include "absl/strings/str_cat.h"
+#include "core/plan/plan_alignment.h"
 #include "core/types/status_macros.h"
 #include "proto/convert.h"
 #include "proto/convert_helpers.h"
@@ -119,6 +120,63 @@ void HoleToProto(const PlanHole& h, v1::PlanHole* m) {
   BandToProto(h.length_tolerance, m->mutable_length_tolerance_mm());
 }
 
+absl::StatusOr<PlanAlignment> AlignmentFromProto(const v1::PlanAlignment& msg,
+                                                 const std::string& field) {
+  PlanAlignment a;
+  switch (msg.mode()) {
+    case v1::ALIGNMENT_MODE_UNSPECIFIED:
+    case v1::ALIGNMENT_MODE_CALIBRATED:
+      a.mode = AlignmentMode::kCalibrated;
+      break;
+    case v1::ALIGNMENT_MODE_RPS:
+      a.mode = AlignmentMode::kRps;
+      break;
+    case v1::ALIGNMENT_MODE_BEST_FIT:
+      a.mode = AlignmentMode::kBestFit;
+      break;
+    default:
+      return Invalid(field + ".mode", "unknown alignment mode");
+  }
+  for (int i = 0; i < msg.references_size(); ++i) {
+    const v1::AlignmentReference& m = msg.references(i);
+    const std::string f = absl::StrCat(field, ".references[", i, "]");
+    AlignmentReference r{m.name(), m.hole(), Eigen::Vector3d::Zero(), 3.0};
+    if (r.hole.empty()) {
+      ASSIGN_OR_RETURN(r.position_mm, Vector3FromProto(m.position_mm(), f + ".position_mm"));
+    }
+    if (m.has_radius_mm()) r.radius_mm = m.radius_mm();
+    a.references.push_back(std::move(r));
+  }
+  a.regions.assign(msg.regions().begin(), msg.regions().end());
+  for (int i = 0; i < msg.locked_size(); ++i)
+    if (!LockDofNamed(msg.locked(i), &a.locked))
+      return Invalid(absl::StrCat(field, ".locked[", i, "]"),
+                     "must be one of tx, ty, tz, rx, ry, rz");
+  if (msg.has_max_correction_mm()) a.max_correction_mm = msg.max_correction_mm();
+  if (msg.has_max_correction_deg()) a.max_correction_deg = msg.max_correction_deg();
+  return a;
+}
+
+void AlignmentToProto(const PlanAlignment& a, v1::PlanAlignment* msg) {
+  const v1::AlignmentMode modes[] = {v1::ALIGNMENT_MODE_CALIBRATED, v1::ALIGNMENT_MODE_RPS,
+                                     v1::ALIGNMENT_MODE_BEST_FIT};
+  msg->set_mode(modes[static_cast<int>(a.mode)]);
+  for (const AlignmentReference& r : a.references) {
+    v1::AlignmentReference* m = msg->add_references();
+    m->set_name(r.name);
+    m->set_hole(r.hole);
+    if (r.hole.empty()) {
+      Vector3ToProto(r.position_mm, m->mutable_position_mm());
+      m->set_radius_mm(r.radius_mm);
+    }
+  }
+  for (const std::string& r : a.regions) msg->add_regions(r);
+  for (int d = 0; d < kRigidDofs; ++d)
+    if (a.locked.IsLocked(d)) msg->add_locked(kDofKeys[d]);
+  msg->set_max_correction_mm(a.max_correction_mm);
+  msg->set_max_correction_deg(a.max_correction_deg);
+}
+
 }  // namespace
 
 absl::StatusOr<InspectionPlan> PlanFromProto(const v1::InspectionPlan& msg,
@@ -167,6 +225,9 @@ absl::StatusOr<InspectionPlan> PlanFromProto(const v1::InspectionPlan& msg,
     if (m.has_min_area_mm2()) d.min_area_mm2 = m.min_area_mm2();
     if (m.has_max_count()) d.max_count = m.max_count();
     plan.defects = d;
+  }
+  if (msg.has_alignment()) {
+    ASSIGN_OR_RETURN(plan.alignment, AlignmentFromProto(msg.alignment(), field + ".alignment"));
   }
   return plan;
 }
@@ -233,6 +294,8 @@ void PlanToProto(const InspectionPlan& plan, v1::InspectionPlan* msg) {
     d->set_min_area_mm2(plan.defects->min_area_mm2);
     if (plan.defects->max_count) d->set_max_count(*plan.defects->max_count);
   }
+  if (plan.alignment.mode != AlignmentMode::kCalibrated)
+    AlignmentToProto(plan.alignment, msg->mutable_alignment());
 }
 
 }  // namespace surfinspect::wire

@@ -174,6 +174,46 @@ void DefectToProto(const Defect& d, v1::DefectResult* msg) {
   msg->set_region(d.region);
 }
 
+// report.json's alignment, typed: made from the report's struct, so the
+// two cannot differ.
+void AlignmentToProto(const ReportAlignment& a, v1::AlignmentResult* msg) {
+  msg->set_mode(a.mode);
+  msg->set_aligned(a.aligned);
+  msg->set_failure(a.failure);
+  msg->set_note(a.note);
+  for (double m : a.matrix) msg->add_matrix(m);
+  Vector3ToProto(a.translation_mm, msg->mutable_translation_mm());
+  Vector3ToProto(a.rotation_deg, msg->mutable_rotation_deg());
+  msg->set_correction_mm(a.correction_mm);
+  msg->set_correction_deg(a.correction_deg);
+  msg->set_max_correction_mm(a.max_correction_mm);
+  msg->set_max_correction_deg(a.max_correction_deg);
+  msg->set_within_max_correction(a.within_max_correction);
+  msg->set_rms_before_mm(a.rms_before_mm);
+  msg->set_rms_after_mm(a.rms_after_mm);
+  msg->set_dofs(a.dofs);
+  for (const std::string& l : a.locked) msg->add_locked(l);
+  msg->set_points_used(a.points_used);
+  msg->set_inliers(a.inliers);
+  msg->set_iterations(a.iterations);
+  msg->set_converged(a.converged);
+  for (const ReportAlignmentReference& r : a.references) {
+    v1::AlignmentReferenceResult* m = msg->add_references();
+    m->set_name(r.name);
+    m->set_kind(r.kind);
+    m->set_measured(r.measured);
+    Vector3ToProto(r.nominal_mm, m->mutable_nominal_mm());
+    Vector3ToProto(r.measured_mm, m->mutable_measured_mm());
+    m->set_points(r.points);
+    for (const ReportLockedDirection& d : r.locked) {
+      v1::AlignmentLockedDirection* x = m->add_locked();
+      Vector3ToProto(d.direction, x->mutable_direction());
+      x->set_before_mm(d.before_mm);
+      x->set_after_mm(d.after_mm);
+    }
+  }
+}
+
 // ErrorMapResponse and InspectResult carry the same typed fields.
 template <typename Msg>
 void OutcomeToProto(const ErrorMapResult& map, const PlanOutcome& outcome, Msg* msg) {
@@ -184,6 +224,8 @@ void OutcomeToProto(const ErrorMapResult& map, const PlanOutcome& outcome, Msg* 
     CharacteristicToProto(c, msg->add_characteristics());
   msg->clear_defects();
   for (const Defect& d : outcome.defects.defects) DefectToProto(d, msg->add_defects());
+  msg->clear_alignment();
+  if (const auto a = ReportAlignmentOf(outcome)) AlignmentToProto(*a, msg->mutable_alignment());
 }
 
 }  // namespace

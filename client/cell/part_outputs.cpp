@@ -8,6 +8,7 @@
 #include "core/pipeline/inspection_report.h"
 #include "core/report/error_map_png.h"
 #include "core/report/qif_results.h"
+#include "core/report/report_content.h"
 #include "core/types/status_macros.h"
 #include "core/types/transform.h"
 #include "proto/convert.h"
@@ -24,6 +25,7 @@ absl::Status FillFromReport(PartOutputs& o) {
   // Extremes are only for the summary line.
   o.min_mm = std::isfinite(report.stats.min_mm) ? report.stats.min_mm : 0.0;
   o.max_mm = std::isfinite(report.stats.max_mm) ? report.stats.max_mm : 0.0;
+  o.alignment = AlignmentLines(report.alignment);
   return absl::OkStatus();
 }
 

@@ -30,8 +30,9 @@ struct PartOutputs {
   double tolerance_mm = 0, color_range_mm = 0;
   // For people: from the report.
   double min_mm = 0, max_mm = 0;
-  std::vector<std::string> failed;   // "name: reason" per failing characteristic
-  std::vector<std::string> defects;  // one line per defect found
+  std::vector<std::string> failed;     // "name: reason" per failing characteristic
+  std::vector<std::string> defects;    // one line per defect found
+  std::vector<std::string> alignment;  // AlignmentLines (core/report/report_content.h)
   // Context for the reports written beside report.json: the cell's name, the
   // part's pose, and its CAD mesh in the part frame (null when not at hand).
   std::string cell;

@@ -109,6 +109,7 @@ void Inspect(const InspectArgs& a) {
   Check(client::WritePartOutputs(a.out, outputs, files));
   std::printf("%s: %s  (min %.3f mm, max %.3f mm)  -> %s\n", part_id.c_str(),
               outputs.verdict.c_str(), outputs.min_mm, outputs.max_mm, a.out.c_str());
+  for (const std::string& line : outputs.alignment) std::printf("  alignment %s\n", line.c_str());
   for (const std::string& line : outputs.failed) std::printf("  failed %s\n", line.c_str());
   for (const std::string& line : outputs.defects) std::printf("  defect %s\n", line.c_str());
   if (store) Record(*store, a, cell, part, part_id);

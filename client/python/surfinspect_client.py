@@ -261,7 +261,7 @@ def read_cell(path):
 _PLAN_KEYS = {
     "plan": {"schema", "tolerance_mm", "allowed_fraction_outside", "min_coverage",
              "coverage_distance_mm", "allow_not_measured", "regions", "points", "sections",
-             "holes", "slots", "edge_points", "defects"},
+             "holes", "slots", "edge_points", "defects", "alignment"},
     "region": {"name", "select", "tolerance_mm", "allowed_fraction_outside", "min_coverage"},
     "select": {"box_mm", "triangles", "group"},
     "point": {"name", "position_mm", "normal", "direction", "radius_mm", "tolerance_mm",
@@ -274,6 +274,9 @@ _PLAN_KEYS = {
              "position_tolerance_mm", "width_tolerance_mm", "length_tolerance_mm", "min_arc_deg"},
     "edge_point": {"name", "position_mm", "radius_mm", "tolerance_mm"},
     "defects": {"threshold_mm", "min_area_mm2", "max_count"},
+    "alignment": {"mode", "references", "regions", "locked", "max_correction_mm",
+                  "max_correction_deg"},
+    "reference": {"name", "hole", "position_mm", "radius_mm"},
     "band": {"lower", "upper"},
 }
 
@@ -410,6 +413,38 @@ def _edge_points(plan, msg):
         _optional_band(e, "tolerance_mm", m.tolerance_mm, where)
 
 
+_ALIGNMENT_MODES = {"calibrated": pb.ALIGNMENT_MODE_CALIBRATED, "rps": pb.ALIGNMENT_MODE_RPS,
+                    "best_fit": pb.ALIGNMENT_MODE_BEST_FIT}
+
+
+def _strings(values, where):
+    if not isinstance(values, list) or not all(isinstance(v, str) for v in values):
+        raise ClientError(f"{where}: must be an array of strings")
+    return values
+
+
+def _alignment(plan, msg):
+    """docs/alignment.md; the server checks the references against the plan."""
+    if "alignment" not in plan:
+        return
+    a, where = plan["alignment"], "plan.alignment"
+    _keys(a, "alignment", where)
+    if a.get("mode") not in _ALIGNMENT_MODES:
+        raise ClientError(f"{where}.mode: must be calibrated, rps or best_fit")
+    m = msg.alignment
+    m.mode = _ALIGNMENT_MODES[a["mode"]]
+    for i, r in enumerate(a.get("references", [])):
+        w = f"{where}.references[{i}]"
+        _keys(r, "reference", w)
+        ref = m.references.add(name=str(r.get("name", "")), hole=str(r.get("hole", "")))
+        if "position_mm" in r:
+            ref.position_mm.extend(_vector3(r["position_mm"], w + ".position_mm"))
+        _optional_numbers(r, ref, w, ("radius_mm",))
+    m.regions.extend(_strings(a.get("regions", []), where + ".regions"))
+    m.locked.extend(_strings(a.get("locked", []), where + ".locked"))
+    _optional_numbers(a, m, where, ("max_correction_mm", "max_correction_deg"))
+
+
 def plan_proto(plan):
     """The JSON plan as the typed InspectionPlan message. Keys and shapes are
     checked here, naming the field; the server checks the values against the
@@ -430,6 +465,7 @@ def plan_proto(plan):
     _sections(plan, msg)
     _holes(plan, msg)
     _edge_points(plan, msg)
+    _alignment(plan, msg)
     if "defects" in plan:
         d = plan["defects"]
         _keys(d, "defects", "plan.defects")

@@ -38,10 +38,8 @@ absl::StatusOr<InspectionResult> InspectPart(const MeshIndex& part,
       progress(InspectionStage::kViewRegistered, views[k].name, out.merged.points_per_view[k]);
   if (IsCancelled(cancel)) return absl::CancelledError("inspect cancelled");
   const InspectionPlan plan = settings.plan ? *settings.plan : PlanFromSettings(settings.error_map);
-  ASSIGN_OR_RETURN(out.error_map, ComputeErrorMap(part, out.merged.cloud_in_world, world_from_part,
-                                                  settings.error_map, cancel));
   // The views as the plan measures holes and edges on them: filtered, in the
-  // part frame.
+  // part frame as calibrated.
   std::vector<PlanView> plan_views;
   const bool edges = !plan.holes.empty() || !plan.edge_points.empty() ||
                      plan.alignment.mode == AlignmentMode::kRps;
@@ -49,22 +47,19 @@ absl::StatusOr<InspectionResult> InspectPart(const MeshIndex& part,
     if (edges)
       plan_views.push_back(
           {v.name, &v.cloud_in_sensor, world_from_part.inverse() * v.world_from_sensor});
-  // The plan's alignment, measured in the calibrated frame; with a
-  // correction the scan is mapped again in the aligned frame and judged
-  // there.
-  AlignmentInputs aligning{part,
-                           out.error_map,
-                           out.merged.cloud_in_world,
-                           world_from_part,
-                           plan_views,
-                           settings.error_map.threads};
+  // The plan's alignment, measured on the scan as calibrated; the scan is
+  // then mapped once, in the frame it gives.
+  const AlignmentInputs aligning{
+      part,       out.merged.cloud_in_world,          world_from_part,
+      plan_views, settings.error_map.max_distance_mm, settings.error_map.threads};
   ASSIGN_OR_RETURN(AlignmentOutcome alignment, MeasureAlignment(aligning, plan, cancel));
+  Eigen::Isometry3d frame = world_from_part;
   if (alignment.aligned) {
-    const Eigen::Isometry3d aligned = world_from_part * alignment.correction.inverse();
-    ASSIGN_OR_RETURN(out.error_map, ComputeErrorMap(part, out.merged.cloud_in_world, aligned,
-                                                    settings.error_map, cancel));
+    frame = world_from_part * alignment.correction.inverse();
     for (PlanView& v : plan_views) v.part_from_sensor = alignment.correction * v.part_from_sensor;
   }
+  ASSIGN_OR_RETURN(out.error_map, ComputeErrorMap(part, out.merged.cloud_in_world, frame,
+                                                  settings.error_map, cancel));
   InspectionPlan judged = plan;  // aligned here, so judged as it now stands
   judged.alignment = PlanAlignment{};
   ASSIGN_OR_RETURN(out.plan, EvaluatePlan(out.error_map, out.merged.cloud_in_world, part.mesh(),

@@ -1,5 +1,8 @@
 #include "core/plan/alignment.h"
 
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -19,36 +22,84 @@ namespace {
 // A surface reference needs this many points within its radius: the
 // median of fewer is at the mercy of a few noisy ones.
 constexpr std::size_t kMinSurfacePoints = 20;
-// The best-fit uses at most this many points (a stride over the matched
-// ones): six unknowns, and each iteration queries every point.
-constexpr std::size_t kMaxFitPoints = 60000;
+// The best-fit uses at most this many points (a stride over the scan):
+// six unknowns, and each iteration queries every point.
+constexpr std::size_t kMaxFitPoints = 20000;
 
 double AngleDeg(const Eigen::Isometry3d& t) {
   return Eigen::AngleAxisd(t.linear()).angle() * 180 / M_PI;
 }
 
+// What an RPS solve and a best-fit both give.
+template <typename Solution>
+void TakeSolution(const Solution& s, AlignmentOutcome& o) {
+  o.aligned = true;
+  o.correction = s.nominal_from_measured;
+  o.x = s.x;
+  o.rms_before_mm = s.rms_before_mm;
+  o.rms_after_mm = s.rms_after_mm;
+  o.iterations = s.iterations;
+  o.converged = s.converged;
+}
+
+// The indices of the valid points of `cloud` for which keep(point) holds,
+// ascending: parallel over blocks, concatenated in block order.
+template <typename Keep>
+std::vector<std::size_t> SelectPoints(const PointCloud& cloud, Keep keep) {
+  constexpr std::size_t kBlock = std::size_t{1} << 16;
+  const std::size_t n = cloud.size(), blocks = (n + kBlock - 1) / kBlock;
+  std::vector<std::vector<std::size_t>> picked(blocks);
+  tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
+    for (std::size_t i = b * kBlock; i < std::min(n, (b + 1) * kBlock); ++i)
+      if (PointCloud::IsValid(cloud.points[i]) && keep(cloud.points[i])) picked[b].push_back(i);
+  });
+  std::vector<std::size_t> out;
+  for (const auto& p : picked) out.insert(out.end(), p.begin(), p.end());
+  return out;
+}
+
 // The surface references' measured places: per reference, the median
-// deviation of the points whose closest CAD point lies within its radius,
-// along its CAD normal. One pass over the map for all of them.
-void MeasureSurfaceReferences(const ErrorMapResult& em, const InspectionPlan& plan,
+// signed distance of the points whose closest CAD point lies within its
+// radius, along its CAD normal. Only the points within radius + the match
+// distance of a reference (a cheap test in the world frame) can qualify;
+// they alone are queried.
+void MeasureSurfaceReferences(const AlignmentInputs& in, const InspectionPlan& plan,
                               std::vector<RpsReference>& refs,
                               std::vector<AlignmentReferenceResult>& out) {
-  std::vector<std::vector<double>> deviations(refs.size());
-  for (std::size_t i = 0; i < em.triangle_id.size(); ++i) {
-    if (em.triangle_id[i] == UINT32_MAX) continue;
-    const Eigen::Vector3d c = em.closest_point[i].cast<double>();
-    for (std::size_t k = 0; k < refs.size(); ++k) {
-      const double r = plan.alignment.references[k].radius_mm;
-      if (out[k].kind == "surface" && (c - refs[k].nominal_mm).squaredNorm() <= r * r)
-        deviations[k].push_back(em.deviation_mm[i]);
-    }
-  }
+  const Eigen::Isometry3d part_from_world = in.world_from_part.inverse();
+  std::vector<std::size_t> surface;
+  std::vector<Eigen::Vector3f> centre;  // per surface reference, world frame
+  std::vector<float> reach2;
   for (std::size_t k = 0; k < refs.size(); ++k) {
     if (out[k].kind != "surface") continue;
-    out[k].points = deviations[k].size();
-    if (deviations[k].size() < kMinSurfacePoints) continue;
-    const double d = MedianInPlace(deviations[k]);
-    refs[k].measured_mm = refs[k].nominal_mm + d * refs[k].directions[0];
+    const double reach = plan.alignment.references[k].radius_mm + std::min(in.max_distance_mm, 1e6);
+    surface.push_back(k);
+    centre.push_back((in.world_from_part * refs[k].nominal_mm).cast<float>());
+    reach2.push_back(static_cast<float>(reach * reach));
+  }
+  const auto near = [&](const Eigen::Vector3f& p, std::size_t j) {
+    return (p - centre[j]).squaredNorm() <= reach2[j];
+  };
+  const std::vector<std::size_t> candidates = SelectPoints(in.cloud_in_world, [&](const auto& p) {
+    for (std::size_t j = 0; j < surface.size(); ++j)
+      if (near(p, j)) return true;
+    return false;
+  });
+  std::vector<std::vector<double>> deviations(surface.size());
+  for (std::size_t i : candidates) {
+    const Eigen::Vector3f& p = in.cloud_in_world.points[i];
+    const ClosestPoint c = in.part.Closest(part_from_world * p.cast<double>(), in.max_distance_mm);
+    for (std::size_t j = 0; j < surface.size() && c.matched(); ++j) {
+      const double r = plan.alignment.references[surface[j]].radius_mm;
+      if (near(p, j) && (c.point - refs[surface[j]].nominal_mm).squaredNorm() <= r * r)
+        deviations[j].push_back(c.signed_distance_mm);
+    }
+  }
+  for (std::size_t j = 0; j < surface.size(); ++j) {
+    const std::size_t k = surface[j];
+    out[k].points = deviations[j].size();
+    if (deviations[j].size() < kMinSurfacePoints) continue;
+    refs[k].measured_mm = refs[k].nominal_mm + MedianInPlace(deviations[j]) * refs[k].directions[0];
     out[k].measured = true;
   }
 }
@@ -86,7 +137,7 @@ absl::StatusOr<AlignmentOutcome> MeasureRps(const AlignmentInputs& in, const Ins
     r.directions = refs[k].directions;
     o.references.push_back(std::move(r));
   }
-  MeasureSurfaceReferences(in.error_map, plan, refs, o.references);
+  MeasureSurfaceReferences(in, plan, refs, o.references);
   RETURN_IF_ERROR(MeasureHoleReferences(in, plan, cancel, refs, o.references));
   for (const AlignmentReferenceResult& r : o.references)
     if (!r.measured) {
@@ -102,14 +153,8 @@ absl::StatusOr<AlignmentOutcome> MeasureRps(const AlignmentInputs& in, const Ins
     o.failure = std::string(solved.status().message());
     return o;
   }
-  o.aligned = true;
-  o.correction = solved->nominal_from_measured;
-  o.x = solved->x;
-  o.rms_before_mm = solved->rms_before_mm;
-  o.rms_after_mm = solved->rms_after_mm;
+  TakeSolution(*solved, o);
   o.dofs = kRigidDofs;
-  o.converged = solved->converged;
-  o.iterations = solved->iterations;
   for (std::size_t k = 0; k < refs.size(); ++k) {
     o.references[k].measured_mm = refs[k].measured_mm;
     o.references[k].before_mm = solved->residuals[k].before_mm;
@@ -120,9 +165,10 @@ absl::StatusOr<AlignmentOutcome> MeasureRps(const AlignmentInputs& in, const Ins
   return o;
 }
 
-// The matched points of the plan's best-fit regions (all when none), in
-// the calibrated part frame, a stride of them when there are many; and the
-// regions' triangle mask for the fit's pairs.
+// The points the best-fit uses, in the calibrated part frame: a stride
+// over the scan's valid points, and with regions, of a four times denser
+// stride those whose closest CAD triangle lies in them (the mask the fit
+// pairs with, also returned).
 absl::StatusOr<PointCloud> FitPoints(const AlignmentInputs& in, const InspectionPlan& plan,
                                      std::vector<uint8_t>* mask) {
   const std::vector<std::string>& names = plan.alignment.regions;
@@ -134,18 +180,29 @@ absl::StatusOr<PointCloud> FitPoints(const AlignmentInputs& in, const Inspection
         (*mask)[t] |= std::find(names.begin(), names.end(),
                                 rp.plan.regions[rp.region_ids[k]].name) != names.end();
   }
-  std::vector<std::size_t> use;
-  const std::vector<uint32_t>& id = in.error_map.triangle_id;
-  for (std::size_t i = 0; i < id.size(); ++i)
-    if (id[i] != UINT32_MAX && (mask->empty() || (*mask)[id[i]])) use.push_back(i);
-  const std::size_t stride =
-      std::max<std::size_t>(1, (use.size() + kMaxFitPoints - 1) / kMaxFitPoints);
   const Eigen::Isometry3d part_from_world = in.world_from_part.inverse();
+  const std::vector<std::size_t> valid =
+      SelectPoints(in.cloud_in_world, [](const auto&) { return true; });
+  const std::size_t want = mask->empty() ? kMaxFitPoints : 4 * kMaxFitPoints;
+  const std::size_t step = std::max<std::size_t>(1, (valid.size() + want - 1) / want);
   std::vector<Eigen::Vector3f> points;
-  for (std::size_t k = 0; k < use.size(); k += stride)
+  for (std::size_t k = 0; k < valid.size(); k += step)
     points.push_back(
-        (part_from_world * in.cloud_in_world.points[use[k]].cast<double>()).cast<float>());
-  return PointCloud::Unorganized(std::move(points));
+        (part_from_world * in.cloud_in_world.points[valid[k]].cast<double>()).cast<float>());
+  if (mask->empty()) return PointCloud::Unorganized(std::move(points));
+  std::vector<uint8_t> in_region(points.size(), 0);
+  tbb::parallel_for(std::size_t{0}, points.size(), [&](std::size_t k) {
+    const ClosestPoint c = in.part.Closest(points[k].cast<double>(), in.max_distance_mm);
+    in_region[k] = c.matched() && (*mask)[c.triangle_id];
+  });
+  std::vector<Eigen::Vector3f> kept;
+  for (std::size_t k = 0; k < points.size(); ++k)
+    if (in_region[k]) kept.push_back(points[k]);
+  const std::size_t cap =
+      std::max<std::size_t>(1, (kept.size() + kMaxFitPoints - 1) / kMaxFitPoints);
+  std::vector<Eigen::Vector3f> fit;
+  for (std::size_t k = 0; k < kept.size(); k += cap) fit.push_back(kept[k]);
+  return PointCloud::Unorganized(std::move(fit));
 }
 
 absl::StatusOr<AlignmentOutcome> MeasureBestFit(const AlignmentInputs& in,
@@ -171,15 +228,9 @@ absl::StatusOr<AlignmentOutcome> MeasureBestFit(const AlignmentInputs& in,
     o.failure = std::string(fit.status().message());
     return o;
   }
-  o.aligned = true;
-  o.correction = fit->nominal_from_measured;
-  o.x = fit->x;
-  o.rms_before_mm = fit->rms_before_mm;
-  o.rms_after_mm = fit->rms_after_mm;
+  TakeSolution(*fit, o);
   o.points_used = fit->points_used;
   o.inliers = fit->inliers;
-  o.iterations = fit->iterations;
-  o.converged = fit->converged;
   o.correction_mm = fit->correction_mm;
   if (!fit->converged)
     o.failure = absl::StrCat("the best-fit did not converge in ", fit->iterations, " steps");
@@ -191,12 +242,12 @@ absl::StatusOr<AlignmentOutcome> MeasureBestFit(const AlignmentInputs& in,
 absl::StatusOr<AlignmentOutcome> MeasureAlignment(const AlignmentInputs& in,
                                                   const InspectionPlan& plan,
                                                   const std::atomic<bool>* cancel) {
-  AlignmentOutcome o;
-  if (plan.alignment.mode == AlignmentMode::kRps) {
-    ASSIGN_OR_RETURN(o, MeasureRps(in, plan, cancel));
-  } else if (plan.alignment.mode == AlignmentMode::kBestFit) {
-    ASSIGN_OR_RETURN(o, MeasureBestFit(in, plan, cancel));
-  }
+  absl::StatusOr<AlignmentOutcome> measured = AlignmentOutcome{};
+  tbb::task_arena(in.threads > 0 ? in.threads : tbb::task_arena::automatic).execute([&] {
+    if (plan.alignment.mode == AlignmentMode::kRps) measured = MeasureRps(in, plan, cancel);
+    if (plan.alignment.mode == AlignmentMode::kBestFit) measured = MeasureBestFit(in, plan, cancel);
+  });
+  ASSIGN_OR_RETURN(AlignmentOutcome o, std::move(measured));
   o.mode = plan.alignment.mode;
   o.max_correction_mm = plan.alignment.max_correction_mm;
   o.max_correction_deg = plan.alignment.max_correction_deg;

@@ -1,16 +1,17 @@
 // The part aligned as the plan asks (PlanAlignment, inspection_plan.h),
-// measured on the error map of the calibrated frame: the correction that
-// maps the scan, placed by the cell's calibration, onto the CAD.
+// measured on the scan as the cell's calibration places it: the correction
+// that maps it onto the CAD.
 //
 //  * rps: each reference measured on the scan (a hole's or slot's centre by
-//    MeasureHoles; a surface point as the median deviation of the points
-//    whose closest CAD point lies within its radius, moved along the CAD
-//    normal), then SolveRps (core/registration/rps_fit.h) on the locked
-//    directions;
-//  * best_fit: RunLockedBestFit (core/registration/locked_best_fit.h) on
-//    the matched points of the plan's regions (or all), a fixed stride of
-//    them when there are many (the fit has 6 unknowns; the stride depends
-//    on the count alone, so the result does not depend on the threads).
+//    MeasureHoles; a surface point as the median signed distance of the
+//    points whose closest CAD point lies within its radius, moved along the
+//    CAD normal: only the points near it are queried), then SolveRps
+//    (core/registration/rps_fit.h) on the locked directions;
+//  * best_fit: RunLockedBestFit (core/registration/locked_best_fit.h) on a
+//    fixed stride of the scan's points (of those whose closest CAD
+//    triangle lies in the plan's regions, when it names some): the fit
+//    has 6 unknowns, and the stride depends on the counts alone, so the
+//    result does not depend on the threads.
 //
 // The caller re-maps the scan with the correction and judges the plan
 // there (core/pipeline/inspection.cpp). The paper's default, calibrated,
@@ -26,7 +27,6 @@
 
 #include "absl/status/statusor.h"
 #include "core/distance/mesh_index.h"
-#include "core/errormap/error_map.h"
 #include "core/plan/characteristics.h"
 #include "core/plan/edge_samples.h"
 #include "core/plan/inspection_plan.h"
@@ -67,13 +67,16 @@ struct AlignmentOutcome {
   bool ok() const { return failure.empty() && within_max_correction; }
 };
 
+// What an alignment is measured on: the scan as the cell's calibration
+// places it, before any error map (the pipeline maps the scan once, in the
+// frame the alignment gives).
 struct AlignmentInputs {
   const MeshIndex& part;
-  const ErrorMapResult& error_map;     // in the calibrated part frame
-  const PointCloud& cloud_in_world;    // the error map's points
+  const PointCloud& cloud_in_world;    // the merged, filtered scan
   Eigen::Isometry3d world_from_part;   // calibrated
-  const std::vector<PlanView>& views;  // for the holes: filtered, part frame
-  int threads = 0;
+  const std::vector<PlanView>& views;  // for the holes: filtered, part frame as calibrated
+  double max_distance_mm = 5.0;        // the error map's: farther points are not matched
+  int threads = 0;                     // 0 = all cores; the result does not depend on it
 };
 
 // Cancelled when `cancel` is raised; every other problem is an outcome's

@@ -13,6 +13,14 @@ namespace surfinspect {
 
 const char* const kDofKeys[kRigidDofs] = {"tx", "ty", "tz", "rx", "ry", "rz"};
 
+bool LockDofNamed(const std::string& key, LockedDofs* locked) {
+  bool* fields[kRigidDofs] = {&locked->tx, &locked->ty, &locked->tz,
+                              &locked->rx, &locked->ry, &locked->rz};
+  for (int d = 0; d < kRigidDofs; ++d)
+    if (key == kDofKeys[d]) return *fields[d] = true;
+  return false;
+}
+
 const char* AlignmentModeName(AlignmentMode mode) {
   switch (mode) {
     case AlignmentMode::kCalibrated:
@@ -32,11 +40,6 @@ using namespace plan_json;  // NOLINT: the plan's JSON reading helpers
 
 constexpr AlignmentMode kModes[] = {AlignmentMode::kCalibrated, AlignmentMode::kRps,
                                     AlignmentMode::kBestFit};
-
-bool* LockedField(LockedDofs& l, int dof) {
-  bool* fields[kRigidDofs] = {&l.tx, &l.ty, &l.tz, &l.rx, &l.ry, &l.rz};
-  return fields[dof];
-}
 
 absl::StatusOr<AlignmentReference> Reference(const json& j, const std::string& path) {
   RETURN_IF_ERROR(CheckKeys(j, path, {"name", "hole", "position_mm", "radius_mm"}));
@@ -59,10 +62,8 @@ absl::Status Locked(const json& j, const std::string& path, LockedDofs& out) {
   if (!j.is_array()) return Bad(path, "must be an array of \"tx\" .. \"rz\"");
   for (std::size_t i = 0; i < j.size(); ++i) {
     ASSIGN_OR_RETURN(auto key, String(j[i], Index(path, i)));
-    const auto* end = kDofKeys + kRigidDofs;
-    const auto* it = std::find(kDofKeys, end, key);
-    if (it == end) return Bad(Index(path, i), "must be one of tx, ty, tz, rx, ry, rz");
-    *LockedField(out, static_cast<int>(it - kDofKeys)) = true;
+    if (!LockDofNamed(key, &out))
+      return Bad(Index(path, i), "must be one of tx, ty, tz, rx, ry, rz");
   }
   return absl::OkStatus();
 }
@@ -124,9 +125,8 @@ json PlanAlignmentJson(const PlanAlignment& a) {
     out["references"].push_back(std::move(j));
   }
   if (!a.regions.empty()) out["regions"] = a.regions;
-  LockedDofs locked = a.locked;
   for (int d = 0; d < kRigidDofs; ++d)
-    if (*LockedField(locked, d)) out["locked"].push_back(kDofKeys[d]);
+    if (a.locked.IsLocked(d)) out["locked"].push_back(kDofKeys[d]);
   return out;
 }
 

@@ -42,7 +42,9 @@ absl::Status ValidatePlanAlignment(const InspectionPlan& plan, const TriangleMes
 std::vector<RpsReference> NominalRpsReferences(const InspectionPlan& plan,
                                                const TriangleMesh& part);
 
-// The directions "tx" .. "rz" name, in Dof order.
+// The degrees of freedom "tx" .. "rz" name, in Dof order.
 extern const char* const kDofKeys[kRigidDofs];
+// Locks the one `key` names; false for a key not in kDofKeys.
+bool LockDofNamed(const std::string& key, LockedDofs* locked);
 
 }  // namespace surfinspect

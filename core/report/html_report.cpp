@@ -78,12 +78,13 @@ std::string Title(const HtmlReportContext& ctx, const InspectionReport& report) 
 std::string SidePane(const InspectionReport& report, const HtmlReportContext& ctx,
                      const DeviationPalette& palette) {
   const std::string sections = SectionPlotsHtml(report, palette);
-  return absl::StrCat(
-      "<aside id=\"side\">\n<h2>Characteristics</h2>\n", CharacteristicsTable(report),
-      "<h2>Defects</h2>\n", DefectsTable(report), sections.empty() ? "" : "<h2>Sections</h2>\n",
-      sections, "<h2>Histogram</h2>\n", HistogramSvg(report.histogram, palette),
-      "<h2>Statistics (all points)</h2>\n", StatisticsTable(report), "<h2>Calibration</h2>\n",
-      CalibrationTable(ctx), "<h2>Settings</h2>\n", SettingsTable(report), "</aside>\n");
+  return absl::StrCat("<aside id=\"side\">\n<h2>Characteristics</h2>\n",
+                      CharacteristicsTable(report), "<h2>Defects</h2>\n", DefectsTable(report),
+                      AlignmentSection(report), sections.empty() ? "" : "<h2>Sections</h2>\n",
+                      sections, "<h2>Histogram</h2>\n", HistogramSvg(report.histogram, palette),
+                      "<h2>Statistics (all points)</h2>\n", StatisticsTable(report),
+                      "<h2>Calibration</h2>\n", CalibrationTable(ctx), "<h2>Settings</h2>\n",
+                      SettingsTable(report), "</aside>\n");
 }
 
 absl::Status CheckInput(const HtmlReportInput& in) {

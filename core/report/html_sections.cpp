@@ -104,6 +104,31 @@ std::string DefectsTable(const InspectionReport& report) {
   return out + "</tbody></table>\n";
 }
 
+std::string AlignmentSection(const InspectionReport& report) {
+  if (!report.alignment) return "";
+  std::string out = "<h2>Alignment</h2>\n<p id=\"alignment-lines\">";
+  for (const std::string& line : AlignmentLines(report.alignment))
+    absl::StrAppend(&out, HtmlEscape(line), "<br>");
+  out += "</p>\n";
+  const ReportTable t = AlignmentTable(report.alignment);
+  if (t.rows.empty()) return out;
+  out += "<table id=\"alignment\"><thead><tr>";
+  for (const std::string& h : t.header) absl::StrAppend(&out, "<th>", h, "</th>");
+  out += "</tr></thead><tbody>\n";
+  for (std::size_t i = 0; i < t.rows.size(); ++i) {
+    out += "<tr>";
+    for (std::size_t k = 0; k < t.rows[i].size(); ++k) {
+      const std::string text = absl::StrReplaceAll(HtmlEscape(t.rows[i][k]), {{"\n", "<br>"}});
+      absl::StrAppend(&out,
+                      k == 2 ? absl::StrCat("<td class=\"", t.failed[i] ? "fail" : "pass", "\">")
+                             : std::string("<td>"),
+                      text, "</td>");
+    }
+    out += "</tr>\n";
+  }
+  return out + "</tbody></table>\n";
+}
+
 std::string StatisticsTable(const InspectionReport& report) {
   return absl::StrCat("<table id=\"statistics\"><tbody>\n",
                       Rows(PointCountFields(report), "", " points"),

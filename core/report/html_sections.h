@@ -35,6 +35,10 @@ std::string CharacteristicsTable(const InspectionReport& report);
 // Defects, one row per defect with data-defect="ID" (the viewer flies there).
 std::string DefectsTable(const InspectionReport& report);
 
+// How the scan was aligned (core/report/report_content.h's lines and
+// references' table, as the PDF prints them); "" for the calibrated frame.
+std::string AlignmentSection(const InspectionReport& report);
+
 // Statistics over all points: the point counts, the statistics and the
 // +-band counts, each with its report key.
 std::string StatisticsTable(const InspectionReport& report);

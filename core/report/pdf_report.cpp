@@ -233,6 +233,18 @@ void DrawTable(Pages& p, const std::string& title, const ReportTable& t,
   p.y += 12;
 }
 
+// How the scan was aligned: its lines, then the RPS references' table.
+void DrawAlignment(Pages& p, const ReportContent& c) {
+  if (c.alignment_lines.empty() && c.alignment.header.empty()) return;
+  p.Need(60);
+  p.y += p.canvas.Text(kLeft, p.y, "Alignment", {10, true}) + 3;
+  for (const std::string& line : c.alignment_lines)
+    p.y += p.canvas.Text(kLeft, p.y, line, {8}, kWidth) + 2;
+  p.y += 6;
+  if (!c.alignment.rows.empty())
+    DrawTable(p, "Alignment references", c.alignment, {70, 40, 45, 120, 80, 80, 80});
+}
+
 // One section's plot (core/report/section_plot.h) scaled into the box (x,
 // y, w, h), y up, with a thin frame: the band's bars, the nominal curve and
 // the whiskers, as the HTML report draws them.
@@ -310,6 +322,7 @@ absl::StatusOr<std::string> RenderPdfReport(const PdfReportInput& in) {
   DrawTable(p, "Characteristics (failed first)", c.characteristics,
             {88, 32, 40, 78, 78, 40, 40, 42, 35, 42});
   DrawTable(p, "Defects", c.defects, {30, 32, 88, 45, 40, 45, 45, 45, 135});
+  DrawAlignment(p, c);
   DrawSections(p, *in.report, c);
   return p.canvas.Finish();
 }

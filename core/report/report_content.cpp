@@ -6,6 +6,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
 
 namespace surfinspect {
 namespace {
@@ -169,7 +170,48 @@ absl::StatusOr<ReportContent> ReportContentFrom(const InspectionReport& report) 
   c.histogram = report.histogram;
   AddCharacteristics(report.characteristics, c);
   AddDefects(report.defects, c);
+  c.alignment_lines = AlignmentLines(report.alignment);
+  c.alignment = AlignmentTable(report.alignment);
   return c;
+}
+
+std::vector<std::string> AlignmentLines(const std::optional<ReportAlignment>& a) {
+  if (!a) return {};
+  std::vector<std::string> lines;
+  if (a->aligned)
+    lines.push_back(absl::StrFormat(
+        "%s: corrected %.3f mm / %.4f deg (allowed %.3g mm / %.3g deg), rms %.4f -> %.4f mm",
+        a->mode, a->correction_mm, a->correction_deg, a->max_correction_mm, a->max_correction_deg,
+        a->rms_before_mm, a->rms_after_mm));
+  if (!a->failure.empty()) lines.push_back(absl::StrCat(a->mode, " failed: ", a->failure));
+  if (!a->note.empty()) lines.push_back(absl::StrCat("note: ", a->note));
+  return lines;
+}
+
+const std::vector<std::string>& AlignmentHeader() {
+  static const std::vector<std::string> header = {"reference", "kind",     "measured", "locks",
+                                                  "before mm", "after mm", "points"};
+  return header;
+}
+
+ReportTable AlignmentTable(const std::optional<ReportAlignment>& a) {
+  ReportTable t;
+  if (!a) return t;
+  t.header = AlignmentHeader();
+  for (const ReportAlignmentReference& r : a->references) {
+    std::vector<std::string> locks, before, after;
+    for (const ReportLockedDirection& d : r.locked) {
+      locks.push_back(
+          absl::StrFormat("(%.3f, %.3f, %.3f)", d.direction.x(), d.direction.y(), d.direction.z()));
+      before.push_back(FormatMm(d.before_mm));
+      after.push_back(FormatMm(d.after_mm));
+    }
+    t.rows.push_back({r.name, r.kind, r.measured ? "yes" : "no", absl::StrJoin(locks, "\n"),
+                      absl::StrJoin(before, "\n"), absl::StrJoin(after, "\n"),
+                      absl::StrCat(r.points)});
+    t.failed.push_back(!r.measured);
+  }
+  return t;
 }
 
 }  // namespace surfinspect

@@ -6,6 +6,7 @@
 // formatted once here, so every renderer prints the same text.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -34,7 +35,20 @@ struct ReportContent {
   ReportTable defects;  // id, kind, region, peak, peak from, area, extent, points, centroid
   std::vector<Defect> defect_marks;  // id and centroid of each defect, for the map
   Histogram histogram;
+  // How the scan was aligned (none for the calibrated frame): its lines for
+  // people, then a row per RPS reference (AlignmentHeader()).
+  std::vector<std::string> alignment_lines;
+  ReportTable alignment;
 };
+
+// The alignment's lines (core/pipeline/report_alignment.h): the correction
+// against its maximum and the RMS, the failure, the caution. None for the
+// calibrated frame. The CLI prints the same lines.
+std::vector<std::string> AlignmentLines(const std::optional<ReportAlignment>& alignment);
+// reference, kind, measured, locks (a direction a line), before mm, after
+// mm (one per direction), points; a reference not measured is a failed row.
+const std::vector<std::string>& AlignmentHeader();
+ReportTable AlignmentTable(const std::optional<ReportAlignment>& alignment);
 
 // A millimetre value as the report prints it: "%+.3f", "-" for null/NaN.
 std::string FormatMm(double v);

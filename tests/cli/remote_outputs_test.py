@@ -32,6 +32,24 @@ def same_json(a, b):
     return ja == jb
 
 
+def aligned_cell(work, cell):
+    """cell/aligned.json: the demo cell calibrated at the simulator's true
+    poses; cell/aligned-plan.json: its plan located by RPS on holes H1 and H4
+    and four surface points (docs/alignment.md)."""
+    for v in cell["viewpoints"]:
+        v["world_from_sensor"] = v["simulation_truth_world_from_sensor"]
+    with open(os.path.join(work, "cell", "aligned.json"), "w") as f:
+        json.dump(cell, f)
+    with open(os.path.join(work, "cell", "plan.json")) as f:
+        plan = json.load(f)
+    plan["alignment"] = {"mode": "rps", "references": [
+        {"name": "A1", "hole": "H1"}, {"name": "A2", "hole": "H4"},
+        {"name": "B1", "position_mm": [-70, 15, 59.5]}, {"name": "B2", "position_mm": [110, -15, 59.0]},
+        {"name": "C1", "position_mm": [-120, 65, -0.9]}, {"name": "C2", "position_mm": [120, -65, -0.9]}]}
+    with open(os.path.join(work, "cell", "aligned-plan.json"), "w") as f:
+        json.dump(plan, f)
+
+
 def main():
     work = tempfile.mkdtemp(prefix="remote-outputs-")
     server = None
@@ -46,6 +64,7 @@ def main():
                 json.dump(v1[key], f)
         with open(os.path.join(work, "wfp.json"), "w") as f:
             json.dump(cell["part"]["world_from_part"], f)
+        aligned_cell(work, cell)
         server = subprocess.Popen([os.path.join(BIN, "surfinspectd"), "--listen", "127.0.0.1:0"],
                                   stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
         target = server.stdout.readline().strip().rsplit(" ", 1)[-1]
@@ -67,6 +86,11 @@ def main():
                                  "--world-from-part", "wfp.json", "--out", "{d}/p.ply", "--png", "{d}/p.png",
                                  "--report", "{d}/p.json", "--tolerance", "0.3", "--plan", "cell/plan.json"],
                                 ["p.ply", "p.png"], ["p.json"]),
+            # A whole part with an RPS alignment: the plan's block travels
+            # typed, the server aligns, and the report says how.
+            "inspect --plan (rps)": (["surfinspect", "inspect", "--cell", "cell/aligned.json", "--scans",
+                                      "cell/scans/part-001", "--out", "{d}/insp", "--plan", "cell/aligned-plan.json"],
+                                     [], ["insp/report.json"]),
         }
         failures = []
         for mode in ("local", "remote"):
@@ -81,6 +105,10 @@ def main():
             for f in reports:
                 if not same_json(os.path.join(work, "local", f), os.path.join(work, "remote", f)):
                     failures.append(f"{name}: {f} differs beyond timing")
+        with open(os.path.join(work, "remote", "insp", "report.json")) as f:
+            alignment = json.load(f).get("alignment", {})
+        if not alignment.get("aligned"):
+            failures.append(f"inspect --plan (rps): not aligned: {alignment}")
         print("\n".join(failures) or f"{len(steps)} steps: identical outputs in-process and via {target}")
         return 1 if failures else 0
     finally:

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "core/pipeline/inspection_report.h"
@@ -173,6 +174,37 @@ TEST(ErrorMapToProto, ReportVerdictAndDeviationsOnlyWhenAsked) {
   EXPECT_TRUE(without.png().empty()) << "the caller's";
 }
 
+TEST(ErrorMapToProto, TheTypedAlignmentIsTheReportsAndUnsetWhenCalibrated) {
+  const ErrorMapSettings settings;
+  v1::ErrorMapResponse calibrated;
+  ErrorMapToProto(SmallMap(true), settings, Outcome(true), false, &calibrated);
+  EXPECT_FALSE(calibrated.has_alignment());
+  PlanOutcome o = Outcome(false);
+  o.alignment.mode = AlignmentMode::kRps;
+  o.alignment.aligned = true;
+  o.alignment.x << 0.1, 0, 0, 0, 0, 0.002;
+  o.alignment.correction = RigidMotion(o.alignment.x).transform();
+  o.alignment.correction_mm = 0.3;
+  o.alignment.within_max_correction = false;
+  o.alignment.references = {
+      {"B1", "surface", true, {1, 2, 3}, {1, 2, 3.1}, {{0, 0, 1}}, {0.1}, {0.001}, 40}};
+  v1::ErrorMapResponse msg;
+  ErrorMapToProto(SmallMap(true), settings, o, false, &msg);
+  ASSERT_TRUE(msg.has_alignment());
+  const auto report = nlohmann::json::parse(msg.report_json())["alignment"];
+  const v1::AlignmentResult& a = msg.alignment();
+  EXPECT_EQ(a.mode(), report["mode"]);
+  EXPECT_EQ(a.within_max_correction(), report["within_max_correction"]);
+  EXPECT_EQ(a.correction_mm(), report["correction_mm"]);
+  ASSERT_EQ(a.matrix_size(), 16);
+  for (int k = 0; k < 16; ++k) EXPECT_EQ(a.matrix(k), report["matrix"][k]);
+  ASSERT_EQ(a.references_size(), 1);
+  EXPECT_EQ(a.references(0).points(), 40u);
+  EXPECT_EQ(a.references(0).locked(0).before_mm(),
+            report["references"][0]["locked"][0]["before_mm"]);
+  EXPECT_EQ(msg.part_verdict(), v1::VERDICT_FAIL);
+}
+
 TEST(InspectionResultToProto, PartIdVerdictReportViewsAndOptionalDeviations) {
   InspectionResult r;
   r.error_map = SmallMap(false);
@@ -301,6 +333,41 @@ TEST(PlanProto, RoundTripsEveryFieldAndUnsetBandsTakeTheSettings) {
   EXPECT_EQ(empty->min_coverage, kDefaultMinCoverage) << "a plan's default, as in the JSON";
   EXPECT_FALSE(empty->allow_not_measured);
   EXPECT_FALSE(empty->defects.has_value());
+}
+
+TEST(PlanProto, AlignmentRoundTripsAndTheCalibratedFrameIsUnset) {
+  InspectionPlan plan;
+  plan.alignment.mode = AlignmentMode::kRps;
+  plan.alignment.references = {{"A1", "H1", Eigen::Vector3d::Zero(), 3.0},
+                               {"B1", "", {1, 2, 3}, 4.5}};
+  plan.alignment.max_correction_mm = 1.25;
+  v1::InspectionPlan msg;
+  PlanToProto(plan, &msg);
+  EXPECT_EQ(msg.alignment().mode(), v1::ALIGNMENT_MODE_RPS);
+  auto back = PlanFromProto(msg, {}, "plan");
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(back->alignment.mode, AlignmentMode::kRps);
+  ASSERT_EQ(back->alignment.references.size(), 2u);
+  EXPECT_EQ(back->alignment.references[0].hole, "H1");
+  EXPECT_EQ(back->alignment.references[1].position_mm, Eigen::Vector3d(1, 2, 3));
+  EXPECT_EQ(back->alignment.references[1].radius_mm, 4.5);
+  EXPECT_EQ(back->alignment.max_correction_mm, 1.25);
+  EXPECT_EQ(back->alignment.max_correction_deg, 1.0);
+  plan.alignment = PlanAlignment{};
+  plan.alignment.mode = AlignmentMode::kBestFit;
+  plan.alignment.regions = {"ridge"};
+  plan.alignment.locked.tz = plan.alignment.locked.rx = true;
+  PlanToProto(plan, &msg);
+  back = PlanFromProto(msg, {}, "plan");
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(back->alignment.regions, std::vector<std::string>{"ridge"});
+  EXPECT_TRUE(back->alignment.locked.tz && back->alignment.locked.rx);
+  EXPECT_EQ(back->alignment.locked.FreeCount(), 4);
+  msg.mutable_alignment()->add_locked("up");
+  EXPECT_EQ(PlanFromProto(msg, {}, "part.plan").status().message(),
+            "part.plan.alignment.locked[2]: must be one of tx, ty, tz, rx, ry, rz");
+  PlanToProto(InspectionPlan{}, &msg);
+  EXPECT_FALSE(msg.has_alignment()) << "the calibrated frame keeps the message as it was";
 }
 
 TEST(PlanProto, ShapesAreCheckedNamingTheField) {

@@ -192,6 +192,33 @@ class PythonClientTest(unittest.TestCase):
         self.assertRegex(r.stderr, "DEADLINE_EXCEEDED|UNAVAILABLE")
         self.assertEqual(self.server.rpcs("Inspect", ("OK",)), 0)
 
+    def test_plan_alignment_goes_into_the_typed_plan(self):
+        import surfinspect_client as sc
+        from surfinspect.v1 import inspection_pb2 as pb
+        msg = sc.plan_proto({"alignment": {
+            "mode": "rps", "max_correction_mm": 1.5,
+            "references": [{"name": "A1", "hole": "H1"},
+                           {"name": "B1", "position_mm": [1, 2, 3], "radius_mm": 4}]}})
+        a = msg.alignment
+        self.assertEqual(a.mode, pb.ALIGNMENT_MODE_RPS)
+        self.assertEqual(a.max_correction_mm, 1.5)
+        self.assertFalse(a.HasField("max_correction_deg"))
+        self.assertEqual([(r.name, r.hole) for r in a.references], [("A1", "H1"), ("B1", "")])
+        self.assertEqual(list(a.references[1].position_mm), [1, 2, 3])
+        self.assertEqual(a.references[1].radius_mm, 4)
+        fit = sc.plan_proto({"alignment": {"mode": "best_fit", "regions": ["ridge"],
+                                           "locked": ["tz", "rx"]}}).alignment
+        self.assertEqual((fit.mode, list(fit.regions), list(fit.locked)),
+                         (pb.ALIGNMENT_MODE_BEST_FIT, ["ridge"], ["tz", "rx"]))
+        self.assertFalse(sc.plan_proto({}).HasField("alignment"))
+        for bad, message in (({"mode": "wobble"}, "plan.alignment.mode: must be"),
+                             ({"mode": "rps", "stiff": 1}, "plan.alignment.stiff: unknown key"),
+                             ({"mode": "best_fit", "locked": "tz"}, "plan.alignment.locked: must be an array"),
+                             ({"mode": "rps", "references": [{"name": "A", "position_mm": [1, 2]}]},
+                              r"plan.alignment.references\[0\].position_mm: must be an array of 3")):
+            with self.assertRaisesRegex(sc.ClientError, message):
+                sc.plan_proto({"alignment": bad})
+
     def test_pcd_reader_ascii_binary_and_interleaved_fields(self):
         import surfinspect_client as sc
         pts = [(1.5, -2.25, 300.0), (math.nan, math.nan, math.nan), (0.125, 4.0, -7.5)]

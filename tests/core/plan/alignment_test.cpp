@@ -16,10 +16,9 @@ namespace {
 struct Fixture {
   TriangleMesh part = MakePillarMesh(300);
   std::unique_ptr<MeshIndex> index = *MeshIndex::Build(part);
-  ErrorMapResult map;  // no points
-  PointCloud cloud;
+  PointCloud cloud;  // no points
   std::vector<PlanView> views;
-  AlignmentInputs in{*index, map, cloud, Eigen::Isometry3d::Identity(), views, 1};
+  AlignmentInputs in{*index, cloud, Eigen::Isometry3d::Identity(), views, 5.0, 1};
 };
 
 TEST(Alignment, TheCalibratedFrameMeasuresNothing) {

@@ -195,6 +195,42 @@ TEST(HtmlReport, AHoleRowShowsSizeTruePositionAndArc) {
       << html.substr(html.find("<table id=\"characteristics\""), 1500);
 }
 
+// An aligned part's side pane shows the alignment's lines and each RPS
+// reference's deviations, before and after, as the PDF prints them; a
+// calibrated report has no alignment section.
+TEST(HtmlReport, AnAlignedPartShowsItsAlignment) {
+  const Points p = SomePoints(100);
+  auto plain = Page(Report(), p);
+  ASSERT_TRUE(plain.ok());
+  EXPECT_EQ(plain->html.find("<h2>Alignment</h2>"), std::string::npos);
+  json r = Report();
+  r["alignment"] = json::parse(R"({
+      "mode": "rps", "aligned": true, "failure": "", "note": "",
+      "matrix": [1,0,0,0.1, 0,1,0,0, 0,0,1,0, 0,0,0,1],
+      "correction_mm": 0.1, "correction_deg": 0.0, "max_correction_mm": 2,
+      "max_correction_deg": 1, "within_max_correction": true, "rms_before_mm": 0.07,
+      "rms_after_mm": 0.002, "dofs": 6,
+      "references": [
+        {"name": "A1", "kind": "hole", "measured": true, "nominal_mm": [0, 0, 0],
+         "measured_mm": [0.1, 0, 0], "points": 120,
+         "locked": [{"direction": [1, 0, 0], "before_mm": 0.1, "after_mm": 0.001},
+                    {"direction": [0, 1, 0], "before_mm": 0.0, "after_mm": -0.002}]},
+        {"name": "B1", "kind": "surface", "measured": false, "nominal_mm": [0, 0, 60],
+         "measured_mm": null, "points": 3, "locked": [{"direction": [0, 0, 1]}]}]})");
+  auto page = Page(r, p);
+  ASSERT_TRUE(page.ok()) << page.status();
+  const std::string& html = page->html;
+  EXPECT_NE(html.find("<h2>Alignment</h2>\n<p id=\"alignment-lines\">rps: corrected 0.100 mm / "
+                      "0.0000 deg (allowed 2 mm / 1 deg), rms 0.0700 -&gt; 0.0020 mm<br></p>"),
+            std::string::npos)
+      << html.substr(html.find("<h2>Alignment</h2>"), 300);
+  EXPECT_NE(html.find("<td>A1</td><td>hole</td><td class=\"pass\">yes</td>"
+                      "<td>(1.000, 0.000, 0.000)<br>(0.000, 1.000, 0.000)</td>"
+                      "<td>+0.100<br>+0.000</td><td>+0.001<br>-0.002</td><td>120</td>"),
+            std::string::npos);
+  EXPECT_NE(html.find("<td>B1</td><td>surface</td><td class=\"fail\">no</td>"), std::string::npos);
+}
+
 TEST(HtmlHistogram, LogAxisKeepsSmallBinsVisible) {
   const std::string svg = HistogramSvg(Typed(Report()).histogram, MakeDeviationPalette(0.3, 1.0));
   // The bin with 1 count is log10(2) / log10(1e6 + 1) ~ 5% of the tallest, not 1e-6.

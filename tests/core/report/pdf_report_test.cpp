@@ -241,6 +241,37 @@ TEST(PdfReport, AHoleRowShowsSizeTruePositionAndArc) {
     EXPECT_NE(text.find(s), std::string::npos) << s << "\n" << text;
 }
 
+// An aligned part prints its alignment's lines and the references' table.
+TEST(PdfReport, AnAlignedPartPrintsItsAlignment) {
+  if (!HavePoppler()) GTEST_SKIP() << "poppler-utils not installed: PDF NOT CHECKED";
+  const Cloud c = MakeCloud(true);
+  InspectionReport report = Report("r");
+  ReportAlignment a;
+  a.mode = "rps";
+  a.aligned = true;
+  a.correction_mm = 0.412;
+  a.correction_deg = 0.21;
+  a.max_correction_mm = 0.3;
+  a.max_correction_deg = 1;
+  a.within_max_correction = false;
+  a.rms_before_mm = 0.2;
+  a.rms_after_mm = 0.004;
+  a.matrix.assign(16, 0);
+  a.references = {{"A1", "hole", true, {0, 0, 0}, {0.1, 0, 0}, 120, {{{1, 0, 0}, 0.25, 0.003}}}};
+  report.alignment = a;
+  PdfReportInput in;
+  in.part_id = "p";
+  in.report = &report;
+  in.points_in_part = &c.points;
+  in.deviation_mm = &c.deviation;
+  TempDir dir;
+  ASSERT_TRUE(WritePdfReport(dir.File("r.pdf"), in).ok());
+  const std::string text = NoSpace(Shell("pdftotext -raw '" + dir.File("r.pdf") + "' -"));
+  for (const char* s : {"Alignment", "rps:corrected0.412mm/0.2100deg(allowed0.3mm/1deg)",
+                        "Alignmentreferences", "A1hole", "+0.250", "+0.003"})
+    EXPECT_NE(text.find(s), std::string::npos) << s << "\n" << text;
+}
+
 // Many rows continue on further pages, each with the table's header.
 TEST(PdfReport, LongTablesContinueOnMorePages) {
   if (!HavePoppler()) GTEST_SKIP() << "poppler-utils not installed: PDF NOT CHECKED";
