@@ -236,7 +236,7 @@ absl::Status SimulateIfAsked(const AgentArgs& a, const CellConfig& cell, const I
     ASSIGN_OR_RETURN(surface, ParseSurfaceDrift(a.drift));
   }
   ASSIGN_OR_RETURN(const auto ids, SimulateParts(cell, layout.inbox, a.simulate, a.seed, surface,
-                                                 drift, a.hole_shift_mm));
+                                                 drift, a.hole_shift_mm, a.fixture_error_mm));
   Tell(out.info,
        absl::StrCat("simulated robot: ", ids.size(), " parts dropped into ", layout.inbox));
   return absl::OkStatus();

@@ -46,6 +46,10 @@ void AddRunOptions(CLI::App* run, AgentArgs& a) {
                   "with --simulate: every third part is made with the CAD's first hole moved MM "
                   "along x in its plane (truth.json \"holes\")")
       ->check(CLI::Range(0.0, 2.0));
+  run->add_option("--fixture-error", a.fixture_error_mm,
+                  "with --simulate: each part sits off in its fixture by up to MM and MM/2 "
+                  "degrees (truth.json \"fixture\"; an rps or best_fit plan recovers it)")
+      ->check(CLI::Range(0.0, 2.0));
   run->add_option("--db", a.db,
                   "results store: SQLite file or postgresql://user@host/db (password from "
                   "PGPASSWORD/PGPASSFILE); default RESULTS/results.db; none = off")

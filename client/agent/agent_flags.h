@@ -18,9 +18,10 @@ struct AgentArgs {
   AgentPaths paths;
   std::string server, tls_ca, tls_cert, tls_key, token_file;
   int simulate = 0;
-  std::string drift;         // --drift SPEC for the simulated parts
-  double hole_shift_mm = 0;  // --hole-shift: every third simulated part's first hole moved
-  std::string db;            // results store; default RESULTS/results.db, "none" = off
+  std::string drift;            // --drift SPEC for the simulated parts
+  double hole_shift_mm = 0;     // --hole-shift: every third simulated part's first hole moved
+  double fixture_error_mm = 0;  // --fixture-error: each simulated part off in its fixture
+  std::string db;               // results store; default RESULTS/results.db, "none" = off
   uint64_t seed = 1;
   bool once = false;
   double poll_s = 1.0, timeout_s = 300;

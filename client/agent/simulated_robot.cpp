@@ -158,7 +158,7 @@ nlohmann::json PlantDrift(const TriangleMesh& part, const SurfaceDrift& drift, i
 // Scans one part at every viewpoint into DIR, then truth.json, then DONE.
 absl::Status DropPart(const CellConfig& cell, const TriangleMesh& part, const fs::path& dir,
                       ScanOptions opt, const nlohmann::json& truth, uint64_t seed, int n,
-                      const RobotDrift& drift) {
+                      const RobotDrift& drift, const Eigen::Isometry3d& in_fixture) {
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) return absl::PermissionDeniedError(dir.string() + ": " + ec.message());
@@ -166,8 +166,8 @@ absl::Status DropPart(const CellConfig& cell, const TriangleMesh& part, const fs
   for (std::size_t v = 0; v < cell.viewpoints.size(); ++v) {
     const CellViewpoint& vp = cell.viewpoints[v];
     opt.seed = seed * 1000003 + n * 101 + v;
-    auto scan =
-        SimulateScan(part, cell.world_from_part, DriftedPose(cell, vp, drift), intrinsics, opt);
+    auto scan = SimulateScan(part, cell.world_from_part * in_fixture, DriftedPose(cell, vp, drift),
+                             intrinsics, opt);
     if (!scan.ok()) return scan.status();
     if (auto st = WritePointCloud((dir / (vp.name + ".pcd")).string(), scan->cloud_in_sensor);
         !st.ok())
@@ -274,11 +274,32 @@ absl::StatusOr<SurfaceDrift> ParseSurfaceDrift(const std::string& spec) {
   return d;
 }
 
+Eigen::Isometry3d RandomFixtureError(std::mt19937_64& rng, double mm) {
+  std::normal_distribution<double> g(0, 1);
+  std::uniform_real_distribution<double> u(0, 1);
+  const Eigen::Vector3d dir(g(rng), g(rng), g(rng)), axis(g(rng), g(rng), g(rng));
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.translate(mm * u(rng) * dir.normalized());
+  t.rotate(Eigen::AngleAxisd(mm / 2 * u(rng) * M_PI / 180, axis.normalized()));
+  return t;
+}
+
+nlohmann::json FixtureTruth(const Eigen::Isometry3d& in_fixture) {
+  nlohmann::json matrix = nlohmann::json::array();
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) matrix.push_back(in_fixture.matrix()(r, c));
+  const Eigen::Vector3d t = in_fixture.translation();
+  return {{"in_fixture", matrix},
+          {"translation_mm", {t.x(), t.y(), t.z()}},
+          {"rotation_deg", Eigen::AngleAxisd(in_fixture.linear()).angle() * 180 / M_PI}};
+}
+
 absl::StatusOr<std::vector<std::string>> SimulateParts(const CellConfig& cell,
                                                        const std::string& inbox, int count,
                                                        uint64_t seed, const SurfaceDrift& drift,
                                                        const RobotDrift& robot,
-                                                       double hole_shift_mm) {
+                                                       double hole_shift_mm,
+                                                       double fixture_error_mm) {
   ASSIGN_OR_RETURN(auto part, ReadCellPartMesh(cell));
   std::optional<MadePart> shifted;
   if (hole_shift_mm > 0) {
@@ -299,8 +320,12 @@ absl::StatusOr<std::vector<std::string>> SimulateParts(const CellConfig& cell,
       truth["drift"] = PlantDrift(part, drift, k - 1, &opt);
     const bool shift = shifted && k % 3 == 0;
     if (shift) truth["holes"] = shifted->truth;
+    const Eigen::Isometry3d in_fixture = fixture_error_mm > 0
+                                             ? RandomFixtureError(rng, fixture_error_mm)
+                                             : Eigen::Isometry3d::Identity();
+    if (fixture_error_mm > 0) truth["fixture"] = FixtureTruth(in_fixture);
     RETURN_IF_ERROR(DropPart(cell, shift ? shifted->mesh : part, fs::path(inbox) / id, opt, truth,
-                             seed, n, robot));
+                             seed, n, robot, in_fixture));
     ids.push_back(id);
   }
   return ids;

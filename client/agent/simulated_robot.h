@@ -10,7 +10,10 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
 #include <optional>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -64,9 +67,21 @@ absl::StatusOr<SurfaceDrift> ParseSurfaceDrift(const std::string& spec);
 // the pose the sensor really scans from. `hole_shift_mm` > 0: every third
 // part (the 3rd, 6th, ...) is made with the CAD's first hole (ListHoles
 // order) moved this far along +x in its plane (core/simulation/
-// hole_changes.h), its truth in truth.json's "holes".
+// hole_changes.h), its truth in truth.json's "holes". `fixture_error_mm` >
+// 0: every part sits off in its fixture by a random rigid motion of up to
+// this many mm and half as many degrees (docs/alignment.md), its truth in
+// truth.json's "fixture".
 absl::StatusOr<std::vector<std::string>> SimulateParts(
     const CellConfig& cell, const std::string& inbox, int count, uint64_t seed,
-    const SurfaceDrift& drift = {}, const RobotDrift& robot = {}, double hole_shift_mm = 0);
+    const SurfaceDrift& drift = {}, const RobotDrift& robot = {}, double hole_shift_mm = 0,
+    double fixture_error_mm = 0);
+
+// A part's placement in its fixture, off by up to `mm` (a random direction)
+// and mm / 2 degrees (about a random axis through the part's origin); its
+// truth as truth.json's "fixture": the matrix (4 x 4 row-major, part frame:
+// the part's points p sit at world_from_part * in_fixture * p), the
+// translation and the rotation angle.
+Eigen::Isometry3d RandomFixtureError(std::mt19937_64& rng, double mm);
+nlohmann::json FixtureTruth(const Eigen::Isometry3d& in_fixture);
 
 }  // namespace surfinspect::client

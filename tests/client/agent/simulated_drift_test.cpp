@@ -3,7 +3,8 @@
 // part, noise 0.015 mm), inspected in-process, written as part outputs,
 // recorded from their files into SQLite exactly as the agent records them;
 // then the fitted slope and the trend map must show the drift, and 30 parts
-// without drift must stay within the rules' false-alarm rate.
+// without drift must stay within the rules' false-alarm rate. And parts
+// placed off in their fixture, with their truth.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -158,6 +159,45 @@ TEST(SimulatedDrift, SpecsAreParsedAndBadOnesNamed) {
     const absl::Status st = ParseSurfaceDrift(bad).status();
     EXPECT_NE(st.message().find(bad), std::string::npos) << st;
   }
+}
+
+}  // namespace
+}  // namespace surfinspect::client
+
+namespace surfinspect::client {
+namespace {
+
+// --fixture-error: each part sits off in its fixture by at most MM and MM/2
+// degrees, its truth in truth.json; its scans move with it (the same seed
+// without the error scans the part where the CAD says).
+TEST(SimulatedFixture, EachPartSitsOffWithinTheBoundAndItsTruthIsWritten) {
+  TempDir dir;
+  const CellConfig cell = SmallCell(dir.path());
+  auto ids = SimulateParts(cell, dir.path() + "/inbox", 4, 7, {}, {}, 0, 1.0);
+  ASSERT_TRUE(ids.ok()) << ids.status();
+  auto plain = SimulateParts(cell, dir.path() + "/plain", 1, 7);
+  ASSERT_TRUE(plain.ok()) << plain.status();
+  for (const std::string& id : *ids) {
+    const nlohmann::json truth =
+        nlohmann::json::parse(std::ifstream(dir.path() + "/inbox/" + id + "/truth.json"));
+    ASSERT_TRUE(truth.contains("fixture")) << truth.dump();
+    const nlohmann::json& f = truth["fixture"];
+    ASSERT_EQ(f["in_fixture"].size(), 16u);
+    const Eigen::Vector3d t(f["translation_mm"][0], f["translation_mm"][1], f["translation_mm"][2]);
+    EXPECT_LE(t.norm(), 1.0 + 1e-12);
+    EXPECT_LE(f["rotation_deg"].get<double>(), 0.5 + 1e-12);
+    EXPECT_EQ(f["in_fixture"][15], 1.0);
+    EXPECT_EQ(f["in_fixture"][3], t.x()) << "row-major: the translation is the last column";
+  }
+  const std::string view = cell.viewpoints[0].name + ".pcd";
+  const PointCloud off = *ReadPointCloud(dir.path() + "/inbox/" + (*ids)[0] + "/" + view);
+  const PointCloud at = *ReadPointCloud(dir.path() + "/plain/" + (*plain)[0] + "/" + view);
+  ASSERT_EQ(off.size(), at.size());
+  double moved = 0;
+  for (std::size_t i = 0; i < off.size(); ++i)
+    if (PointCloud::IsValid(off.points[i]) && PointCloud::IsValid(at.points[i]))
+      moved = std::max(moved, double((off.points[i] - at.points[i]).norm()));
+  EXPECT_GT(moved, 0.05) << "the displaced part's scan did not move";
 }
 
 }  // namespace
