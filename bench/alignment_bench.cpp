@@ -1,8 +1,8 @@
 // The cost of aligning a part (core/plan/alignment.h) next to the error map
 // it precedes: the demo pillar seen from its top viewpoint by a 2048 x 1536
 // sensor (~2 M points, noise 0.015 mm), displaced in its fixture by 0.4 mm
-// and 0.2 degrees. Timed: RPS on the two holes of the top and four surface
-// points, and a best-fit restricted to the ridge region (x locked: a channel
+// and 0.2 degrees. Timed: RPS on two holes of the top and four surface
+// points (DemoRpsAlignment), and a best-fit restricted to the ridge region (x locked: a channel
 // along x barely holds the part along it), each measured on
 // the scan as calibrated; the pipeline then computes its one error map in
 // the aligned frame. Goals (the alignment issue): RPS at most 5%, a region
@@ -40,18 +40,6 @@ double BestOf3(const std::function<void()>& f) {
   return best;
 }
 
-// The top holes nearest (x, y) by name, from the CAD's list.
-std::string HoleNear(const json& holes, double x, double y) {
-  std::string best;
-  double d = 1e30;
-  for (const json& h : holes["holes"]) {
-    const double e =
-        std::hypot(h["position_mm"][0].get<double>() - x, h["position_mm"][1].get<double>() - y);
-    if (e < d) d = e, best = h["name"];
-  }
-  return best;
-}
-
 json Plan(const DemoCell& cell, const json& alignment) {
   const json holes = PlanHolesJson(ListHoles(cell.part), 0.3);
   return {{"min_coverage", 0},
@@ -60,19 +48,6 @@ json Plan(const DemoCell& cell, const json& alignment) {
           {"regions",
            {{{"name", "ridge"}, {"select", {{"box_mm", {{-150, -25, 0}, {150, 25, 200}}}}}}}},
           {"alignment", alignment}};
-}
-
-json Rps(const DemoCell& cell) {
-  const json holes = PlanHolesJson(ListHoles(cell.part), 0.3);
-  auto top = [&](double x, double y) { return json{x, y, PillarRidgeZ(x, cell.part_length_mm)}; };
-  return {{"mode", "rps"},
-          {"references",
-           {{{"name", "A1"}, {"hole", HoleNear(holes, -110, 0)}},
-            {{"name", "A2"}, {"hole", HoleNear(holes, 35, 10)}},
-            {{"name", "B1"}, {"position_mm", top(-70, 15)}},
-            {{"name", "B2"}, {"position_mm", top(110, -15)}},
-            {{"name", "B3"}, {"position_mm", top(-40, -15)}},
-            {{"name", "B4"}, {"position_mm", top(80, 15)}}}}};
 }
 
 int Run() {
@@ -104,7 +79,8 @@ int Run() {
               em->stats.matched);
   std::printf("error map          %8.1f ms\n", 1e3 * t_map);
   for (const json& alignment :
-       {Rps(cell), json{{"mode", "best_fit"}, {"regions", {"ridge"}}, {"locked", {"tx"}}}}) {
+       {DemoRpsAlignment(cell),
+        json{{"mode", "best_fit"}, {"regions", {"ridge"}}, {"locked", {"tx"}}}}) {
     auto plan = ParseInspectionPlan(Plan(cell, alignment), cell.part);
     if (!plan.ok()) return std::fprintf(stderr, "%s\n", plan.status().ToString().c_str()), 1;
     absl::StatusOr<AlignmentOutcome> a;

@@ -1,9 +1,12 @@
 #include "core/simulation/demo_cell.h"
 
+#include <cmath>
 #include <random>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "core/plan/cad_holes.h"
+#include "core/plan/inspection_plan.h"
 #include "core/types/transform.h"
 
 namespace surfinspect {
@@ -143,6 +146,32 @@ absl::StatusOr<SimulatedScan> SimulateDemoGaugeScan(const DemoCell& cell, std::s
   gauge_opt.seed = scan.seed * 1000 + v;
   return SimulateScan(cell.gauge, vp.world_from_gauge, vp.world_from_sensor, cell.intrinsics,
                       gauge_opt);
+}
+
+nlohmann::json DemoRpsAlignment(const DemoCell& cell) {
+  const nlohmann::json holes = PlanHolesJson(ListHoles(cell.part), 0.3);
+  const auto near = [&](double x, double y) {
+    std::string best;
+    double d = INFINITY;
+    for (const nlohmann::json& h : holes["holes"]) {
+      const double e =
+          std::hypot(h["position_mm"][0].get<double>() - x, h["position_mm"][1].get<double>() - y);
+      if (e < d) d = e, best = h["name"];
+    }
+    return best;
+  };
+  const double len = cell.part_length_mm;
+  const auto at = [&](double x, double y, double below) {
+    return nlohmann::json{x, y, PillarRidgeZ(x, len) - below};
+  };
+  return {{"mode", "rps"},
+          {"references",
+           {{{"name", "A1"}, {"hole", near(-110, 0)}},
+            {{"name", "A2"}, {"hole", near(35, 10)}},
+            {{"name", "B1"}, {"position_mm", at(-70, 15, 0)}},
+            {{"name", "B2"}, {"position_mm", at(110, -15, 0)}},
+            {{"name", "C1"}, {"position_mm", at(-120, 65, 60)}},
+            {{"name", "C2"}, {"position_mm", at(120, -65, 60)}}}}};
 }
 
 absl::StatusOr<SimulatedScan> SimulateDemoPartScan(const DemoCell& cell, const DemoPart& part,

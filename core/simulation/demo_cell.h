@@ -11,6 +11,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -74,6 +75,13 @@ struct DemoPart {
 // Parts 1..count with their defects, drawn from `scan_seed` (the seed of the
 // production scans' ScanOptions).
 std::vector<DemoPart> MakeDemoParts(const DemoCell& cell, int count, uint64_t scan_seed);
+
+// An RPS alignment for the demo part (docs/alignment.md): its round holes
+// of the top nearest (-110, 0) and (35, 10) by their names in
+// PlanHolesJson(ListHoles(cell.part)) order, and four surface points, two
+// on the top and two on the flanges, clear of the holes. A plan's
+// "alignment" block.
+nlohmann::json DemoRpsAlignment(const DemoCell& cell);
 
 // The gauge scan of viewpoint v (index into cell.viewpoints): `scan`'s noise
 // and outliers without defects, seeded by scan.seed and v.

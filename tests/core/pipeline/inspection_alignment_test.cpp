@@ -45,18 +45,6 @@ class InspectionAlignment : public ::testing::Test {
     delete cell_;
   }
 
-  // The plan hole of the CAD nearest (x, y).
-  static std::string HoleNear(const json& holes, double x, double y) {
-    std::string best;
-    double d = INFINITY;
-    for (const json& h : holes["holes"]) {
-      const double e =
-          std::hypot(h["position_mm"][0].get<double>() - x, h["position_mm"][1].get<double>() - y);
-      if (e < d) d = e, best = h["name"];
-    }
-    return best;
-  }
-
   // The surface band, the CAD's holes, a ridge region, and the alignment.
   static json Plan(const json& alignment) {
     const json holes = PlanHolesJson(ListHoles(cell_->part), 0.3);
@@ -74,20 +62,7 @@ class InspectionAlignment : public ::testing::Test {
 
   // RPS: the two round holes of the top lock x and y (and the turn about
   // z); four surface points on the top and the flanges lock z and the tilts.
-  static json Rps() {
-    const json holes = PlanHolesJson(ListHoles(cell_->part), 0.3);
-    const double len = cell_->part_length_mm;
-    auto top = [&](double x, double y) { return json{x, y, PillarRidgeZ(x, len)}; };
-    auto flange = [&](double x, double y) { return json{x, y, PillarRidgeZ(x, len) - 60}; };
-    return {{"mode", "rps"},
-            {"references",
-             {{{"name", "A1"}, {"hole", HoleNear(holes, -110, 0)}},
-              {{"name", "A2"}, {"hole", HoleNear(holes, 35, 10)}},
-              {{"name", "B1"}, {"position_mm", top(-70, 15)}},
-              {{"name", "B2"}, {"position_mm", top(110, -15)}},
-              {{"name", "C1"}, {"position_mm", flange(-120, 65)}},
-              {{"name", "C2"}, {"position_mm", flange(120, -65)}}}}};
-  }
+  static json Rps() { return DemoRpsAlignment(*cell_); }
 
   static absl::StatusOr<InspectionResult> Inspect(const testing::ScannedPart& s, const json& plan,
                                                   const Eigen::Isometry3d& world_from_part) {

@@ -212,9 +212,22 @@ TEST(PdfReport, BadInputsAreErrorsNotCrashes) {
 
 // A hole's row: its diameter with the deviation, its true position against
 // the zone and the arc seen, in the characteristics table.
+// The PDF of `report` over MakeCloud(true), as pdftotext reads it, without
+// spaces.
+std::string PdfText(const InspectionReport& report) {
+  const Cloud c = MakeCloud(true);
+  PdfReportInput in;
+  in.part_id = "p";
+  in.report = &report;
+  in.points_in_part = &c.points;
+  in.deviation_mm = &c.deviation;
+  TempDir dir;
+  EXPECT_TRUE(WritePdfReport(dir.File("r.pdf"), in).ok());
+  return NoSpace(Shell("pdftotext -raw '" + dir.File("r.pdf") + "' -"));
+}
+
 TEST(PdfReport, AHoleRowShowsSizeTruePositionAndArc) {
   if (!HavePoppler()) GTEST_SKIP() << "poppler-utils not installed: PDF NOT CHECKED";
-  const Cloud c = MakeCloud(true);
   InspectionReport report = Report("r");
   ReportCharacteristic h;
   h.name = "H1";
@@ -228,14 +241,7 @@ TEST(PdfReport, AHoleRowShowsSizeTruePositionAndArc) {
   h.diameter_deviation_mm = 0.012;
   h.arc_coverage_deg = 351;
   report.characteristics.push_back(h);
-  PdfReportInput in;
-  in.part_id = "p";
-  in.report = &report;
-  in.points_in_part = &c.points;
-  in.deviation_mm = &c.deviation;
-  TempDir dir;
-  ASSERT_TRUE(WritePdfReport(dir.File("r.pdf"), in).ok());
-  const std::string text = NoSpace(Shell("pdftotext -raw '" + dir.File("r.pdf") + "' -"));
+  const std::string text = PdfText(report);
   for (const char* s :
        {"\u00d88.012(+0.012)", "TP0.310/0.300", "arc351\u00b0", "\u00d8-0.100/+0.100", "TP0.300"})
     EXPECT_NE(text.find(s), std::string::npos) << s << "\n" << text;
@@ -244,7 +250,6 @@ TEST(PdfReport, AHoleRowShowsSizeTruePositionAndArc) {
 // An aligned part prints its alignment's lines and the references' table.
 TEST(PdfReport, AnAlignedPartPrintsItsAlignment) {
   if (!HavePoppler()) GTEST_SKIP() << "poppler-utils not installed: PDF NOT CHECKED";
-  const Cloud c = MakeCloud(true);
   InspectionReport report = Report("r");
   ReportAlignment a;
   a.mode = "rps";
@@ -259,14 +264,7 @@ TEST(PdfReport, AnAlignedPartPrintsItsAlignment) {
   a.matrix.assign(16, 0);
   a.references = {{"A1", "hole", true, {0, 0, 0}, {0.1, 0, 0}, 120, {{{1, 0, 0}, 0.25, 0.003}}}};
   report.alignment = a;
-  PdfReportInput in;
-  in.part_id = "p";
-  in.report = &report;
-  in.points_in_part = &c.points;
-  in.deviation_mm = &c.deviation;
-  TempDir dir;
-  ASSERT_TRUE(WritePdfReport(dir.File("r.pdf"), in).ok());
-  const std::string text = NoSpace(Shell("pdftotext -raw '" + dir.File("r.pdf") + "' -"));
+  const std::string text = PdfText(report);
   for (const char* s : {"Alignment", "rps:corrected0.412mm/0.2100deg(allowed0.3mm/1deg)",
                         "Alignmentreferences", "A1hole", "+0.250", "+0.003"})
     EXPECT_NE(text.find(s), std::string::npos) << s << "\n" << text;

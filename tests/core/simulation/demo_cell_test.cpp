@@ -3,9 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <filesystem>
 
 #include "core/io/io_point_cloud.h"
+#include "core/plan/cad_holes.h"
+#include "core/plan/inspection_plan.h"
 #include "core/types/transform.h"
 #include "tests/support/temp_dir.h"
 
@@ -59,6 +62,25 @@ TEST(DemoCell, FiveViewpointsSeeTheRidgeAndTheirGauges) {
     const Bounds3 b = ComputeBounds(part_scan->cloud_in_sensor);
     EXPECT_GT(b.min.z(), 300.0);
     EXPECT_LT(b.max.z(), 520.0);
+  }
+}
+
+// The demo's RPS set names two round holes of the top and locks all six
+// degrees of freedom on the demo part (its plan validates).
+TEST(DemoCell, TheRpsAlignmentLocksTheDemoPart) {
+  const DemoCell cell = MakeDemoCell();
+  const nlohmann::json a = DemoRpsAlignment(cell);
+  ASSERT_EQ(a["references"].size(), 6u);
+  const nlohmann::json holes = PlanHolesJson(ListHoles(cell.part), 0.3);
+  nlohmann::json plan = {{"holes", holes["holes"]}, {"slots", holes["slots"]}, {"alignment", a}};
+  auto parsed = ParseInspectionPlan(plan, cell.part);
+  ASSERT_TRUE(parsed.ok()) << parsed.status();
+  for (int k : {0, 1}) {
+    const std::string name = a["references"][k]["hole"];
+    const auto it = std::find_if(parsed->holes.begin(), parsed->holes.end(),
+                                 [&](const PlanHole& h) { return h.name == name; });
+    ASSERT_NE(it, parsed->holes.end());
+    EXPECT_GT(it->position_mm.z(), 50) << name << " lies on the top";
   }
 }
 
