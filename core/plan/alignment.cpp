@@ -12,7 +12,6 @@
 #include "core/plan/plan_alignment.h"
 #include "core/registration/locked_best_fit.h"
 #include "core/registration/rps_fit.h"
-#include "core/types/cancel.h"
 #include "core/types/percentile.h"
 #include "core/types/status_macros.h"
 
@@ -98,7 +97,11 @@ void MeasureSurfaceReferences(const AlignmentInputs& in, const InspectionPlan& p
   for (std::size_t j = 0; j < surface.size(); ++j) {
     const std::size_t k = surface[j];
     out[k].points = deviations[j].size();
-    if (deviations[j].size() < kMinSurfacePoints) continue;
+    if (deviations[j].size() < kMinSurfacePoints) {
+      out[k].reason = absl::StrCat(out[k].points, " points within its radius, at least ",
+                                   kMinSurfacePoints, " needed");
+      continue;
+    }
     refs[k].measured_mm = refs[k].nominal_mm + MedianInPlace(deviations[j]) * refs[k].directions[0];
     out[k].measured = true;
   }
@@ -119,6 +122,7 @@ absl::Status MeasureHoleReferences(const AlignmentInputs& in, const InspectionPl
     AlignmentReferenceResult& r = out[which[j]];
     r.points = measured[j].edge_points;
     r.measured = measured[j].measured;
+    r.reason = measured[j].reason;
     if (r.measured) refs[which[j]].measured_mm = measured[j].measured_position_mm;
   }
   return absl::OkStatus();
@@ -141,11 +145,9 @@ absl::StatusOr<AlignmentOutcome> MeasureRps(const AlignmentInputs& in, const Ins
   RETURN_IF_ERROR(MeasureHoleReferences(in, plan, cancel, refs, o.references));
   for (const AlignmentReferenceResult& r : o.references)
     if (!r.measured) {
-      o.failure =
-          r.kind == "surface"
-              ? absl::StrCat("reference ", r.name, ": ", r.points,
-                             " points within its radius, at least ", kMinSurfacePoints, " needed")
-              : absl::StrCat("reference ", r.name, ": its ", r.kind, " was not measured");
+      o.failure = r.kind == "surface" ? absl::StrCat("reference ", r.name, ": ", r.reason)
+                                      : absl::StrCat("reference ", r.name, ": its ", r.kind,
+                                                     " was not measured (", r.reason, ")");
       return o;
     }
   auto solved = SolveRps(refs);

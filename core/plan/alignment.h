@@ -43,6 +43,7 @@ struct AlignmentReferenceResult {
   std::vector<Eigen::Vector3d> directions;                       // the ones it locks
   std::vector<double> before_mm, after_mm;                       // deviation along each direction
   std::size_t points = 0;  // surface: points within radius; hole: edge points
+  std::string reason;      // why not measured, for people
 };
 
 struct AlignmentOutcome {

@@ -187,7 +187,7 @@ TEST(ErrorMapToProto, TheTypedAlignmentIsTheReportsAndUnsetWhenCalibrated) {
   o.alignment.correction_mm = 0.3;
   o.alignment.within_max_correction = false;
   o.alignment.references = {
-      {"B1", "surface", true, {1, 2, 3}, {1, 2, 3.1}, {{0, 0, 1}}, {0.1}, {0.001}, 40}};
+      {"B1", "surface", true, {1, 2, 3}, {1, 2, 3.1}, {{0, 0, 1}}, {0.1}, {0.001}, 40, ""}};
   v1::ErrorMapResponse msg;
   ErrorMapToProto(SmallMap(true), settings, o, false, &msg);
   ASSERT_TRUE(msg.has_alignment());

@@ -25,8 +25,8 @@ PlanOutcome WithRps() {
   a.rms_before_mm = 0.2;
   a.rms_after_mm = 0.004;
   a.dofs = 6;
-  AlignmentReferenceResult hole{"A1", "hole", true, {-110, 0, 60}, {-109.9, 0.2, 60}, {},
-                                {},   {},     88};
+  AlignmentReferenceResult hole{"A1", "hole", true, {-110, 0, 60}, {-109.9, 0.2, 60}, {}, {},
+                                {},   88,     ""};
   hole.directions = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY()};
   hole.before_mm = {0.1, 0.2};
   hole.after_mm = {0.001, -0.002};

@@ -45,6 +45,24 @@ TEST(Alignment, AnUnseenReferenceIsAFailureNamingIt) {
   EXPECT_FALSE(a->references[0].measured);
 }
 
+TEST(Alignment, AnUnmeasuredHoleReferenceIsAFailureWithTheHolesReason) {
+  Fixture f;
+  InspectionPlan plan;
+  PlanHole h;
+  h.name = "H1";
+  h.position_mm = {-110, 0, PillarRidgeZ(-110, 300)};
+  h.diameter_mm = 8;
+  plan.holes = {h};
+  plan.alignment.mode = AlignmentMode::kRps;
+  plan.alignment.references = {{"A1", "H1", Eigen::Vector3d::Zero(), 3.0}};
+  auto a = MeasureAlignment(f.in, plan);
+  ASSERT_TRUE(a.ok()) << a.status();
+  EXPECT_FALSE(a->aligned);
+  EXPECT_EQ(a->failure,
+            "reference A1: its hole was not measured (no organized views (holes are measured by "
+            "inspect))");
+}
+
 TEST(Alignment, AFailedOrExcessiveAlignmentFailsThePartReasonFirst) {
   CharacteristicsResult passed;
   passed.pass = true;
