@@ -2,11 +2,11 @@
 // it precedes: the demo pillar seen from its top viewpoint by a 2048 x 1536
 // sensor (~2 M points, noise 0.015 mm), displaced in its fixture by 0.4 mm
 // and 0.2 degrees. Timed: RPS on two holes of the top and four surface
-// points (DemoRpsAlignment), and a best-fit restricted to the ridge region (x locked: a channel
-// along x barely holds the part along it), each measured on
-// the scan as calibrated; the pipeline then computes its one error map in
-// the aligned frame. Goals (the alignment issue): RPS at most 5%, a region
-// best-fit at most 50% of the error map. Best of 3, 2 threads.
+// points (DemoRpsAlignment), and a best-fit restricted to the ridge region
+// (x locked: a channel along x barely holds the part along it), each
+// measured on the scan as calibrated; the pipeline then computes its one
+// error map in the aligned frame. Goals: RPS at most 5%, a region best-fit
+// at most 50% of the error map. Best of 3, 2 threads.
 //
 //   build/bin/alignment_bench
 #include <algorithm>

@@ -1,12 +1,12 @@
 // Alignment end to end (core/plan/alignment.cpp through InspectPart) on
 // simulated demo parts displaced in their fixture by known amounts (the
 // simulator's truth, DemoPart::in_fixture): RPS on two holes and four
-// surface points recovers the placement within the pitch-bounded limits of
-// the issue; the surface judged after RPS equals the surface judged under
-// the true placement; a bent ridge still fails after RPS while a
-// whole-part best-fit hides part of it (and says so); locked degrees of
-// freedom stay exactly zero; a correction beyond the allowed maximum fails
-// the part with that reason.
+// surface points recovers the placement within pitch-bounded limits (the
+// in-plane terms rest on the hole centres); the surface judged after RPS
+// equals the surface judged under the true placement; a bent ridge still
+// fails after RPS while a whole-part best-fit hides part of it (and says
+// so); locked degrees of freedom stay exactly zero; a correction beyond the
+// allowed maximum fails the part with that reason.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -27,7 +27,7 @@ namespace {
 using Eigen::Vector3d;
 using nlohmann::json;
 
-// The issue's bounds at the demo's ~0.27 mm pitch: 0.15 pitch at the
+// The bounds at the demo's ~0.27 mm pitch: 0.15 pitch at the
 // part's extent, 0.1 pixel over the ~145 mm between the locating holes.
 constexpr double kPoseBoundMm = 0.04;
 constexpr double kAngleBoundDeg = 0.01;
