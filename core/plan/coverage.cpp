@@ -92,6 +92,7 @@ class EdgeBands {
     q_.resize(offsets_.back());
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, triangles, 64), [&](auto range) {
       for (uint32_t t = range.begin(); t != range.end(); ++t) {
+        if (!wanted[t]) continue;
         uint32_t at[3] = {offsets_[3 * t], offsets_[3 * t + 1], offsets_[3 * t + 2]};
         for (uint32_t i = points.begin(t); i < points.end(t); ++i)
           for (int k = 0; k < 3; ++k)
