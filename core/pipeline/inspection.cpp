@@ -43,8 +43,8 @@ absl::StatusOr<InspectionResult> InspectPart(const MeshIndex& part,
   std::vector<PlanView> plan_views;
   const bool edges = !plan.holes.empty() || !plan.edge_points.empty() ||
                      plan.alignment.mode == AlignmentMode::kRps;
-  for (const ViewScan& v : views)
-    if (edges)
+  if (edges)
+    for (const ViewScan& v : views)
       plan_views.push_back(
           {v.name, &v.cloud_in_sensor, world_from_part.inverse() * v.world_from_sensor});
   // The plan's alignment, measured on the scan as calibrated; the scan is

@@ -163,8 +163,8 @@ TEST_F(InspectionAlignment, ABentRidgeStillFailsAfterRpsWhileAWholePartBestFitHi
   ASSERT_TRUE(fit.ok()) << fit.status();
   ASSERT_TRUE(fit->plan.alignment.aligned) << fit->plan.alignment.failure;
   // The robust kernel (Tukey's) gives the bend's core no weight, so the
-  // fit leans only on its tails: measured 5 um here. A least-squares fit
-  // would lean far more.
+  // fit leans only on its tails (the test prints both peaks). A
+  // least-squares fit would lean far more.
   EXPECT_LT(Named(*fit, "ridge").max_mm, ridge.max_mm - 0.002) << "the fit leans into the bend";
   EXPECT_NE(fit->plan.alignment.note.find("whole part"), std::string::npos);
   std::cout << "ridge peak after RPS " << ridge.max_mm << " mm, after a whole-part best-fit "

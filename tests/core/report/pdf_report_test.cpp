@@ -97,17 +97,23 @@ Cloud MakeCloud(bool organized) {
   return c;
 }
 
+// The renderer's input: `report` over the cloud `c`.
+PdfReportInput InputOf(const std::string& part_id, const InspectionReport& report, const Cloud& c) {
+  PdfReportInput in;
+  in.part_id = part_id;
+  in.report = &report;
+  in.points_in_part = &c.points;
+  in.deviation_mm = &c.deviation;
+  return in;
+}
+
 TEST(PdfReport, ForeignStringsRenderLiterallyOnAnA4PageWithEmbeddedFonts) {
   if (!HavePoppler()) GTEST_SKIP() << "poppler-utils (pdftotext) not installed: PDF NOT CHECKED";
   const Cloud c = MakeCloud(true);
   const InspectionReport report = Report(kNasty);
-  PdfReportInput in;
-  in.part_id = std::string("part \"1\" <i>&amp;</i> '") + kNasty;
+  PdfReportInput in = InputOf(std::string("part \"1\" <i>&amp;</i> '") + kNasty, report, c);
   in.cell = "cell <7>";
   in.time_utc = "2026-12-01 10:00:00 UTC";
-  in.report = &report;
-  in.points_in_part = &c.points;
-  in.deviation_mm = &c.deviation;
   TempDir dir;
   const std::string pdf = dir.File("r.pdf");
   ASSERT_TRUE(WritePdfReport(pdf, in).ok());
@@ -146,11 +152,7 @@ TEST(PdfReport, RenderedMapAreaIsNotBlank) {
   for (bool organized : {true, false}) {
     const Cloud c = MakeCloud(organized);
     const InspectionReport report = Report("top");
-    PdfReportInput in;
-    in.part_id = "p1";
-    in.report = &report;
-    in.points_in_part = &c.points;
-    in.deviation_mm = &c.deviation;
+    const PdfReportInput in = InputOf("p1", report, c);
     TempDir dir;
     ASSERT_TRUE(WritePdfReport(dir.File("r.pdf"), in).ok());
     // 72 dpi: one pixel per PDF point.
@@ -210,22 +212,17 @@ TEST(PdfReport, BadInputsAreErrorsNotCrashes) {
   EXPECT_FALSE(WritePdfReport(dir.File("no/such/dir/r.pdf"), in).ok());
 }
 
-// A hole's row: its diameter with the deviation, its true position against
-// the zone and the arc seen, in the characteristics table.
 // The PDF of `report` over MakeCloud(true), as pdftotext reads it, without
 // spaces.
 std::string PdfText(const InspectionReport& report) {
   const Cloud c = MakeCloud(true);
-  PdfReportInput in;
-  in.part_id = "p";
-  in.report = &report;
-  in.points_in_part = &c.points;
-  in.deviation_mm = &c.deviation;
   TempDir dir;
-  EXPECT_TRUE(WritePdfReport(dir.File("r.pdf"), in).ok());
+  EXPECT_TRUE(WritePdfReport(dir.File("r.pdf"), InputOf("p", report, c)).ok());
   return NoSpace(Shell("pdftotext -raw '" + dir.File("r.pdf") + "' -"));
 }
 
+// A hole's row: its diameter with the deviation, its true position against
+// the zone and the arc seen, in the characteristics table.
 TEST(PdfReport, AHoleRowShowsSizeTruePositionAndArc) {
   if (!HavePoppler()) GTEST_SKIP() << "poppler-utils not installed: PDF NOT CHECKED";
   InspectionReport report = Report("r");
@@ -280,13 +277,8 @@ TEST(PdfReport, LongTablesContinueOnMorePages) {
     ch.name = "row-" + std::to_string(i);
     report.characteristics.push_back(ch);
   }
-  PdfReportInput in;
-  in.part_id = "p";
-  in.report = &report;
-  in.points_in_part = &c.points;
-  in.deviation_mm = &c.deviation;
   TempDir dir;
-  ASSERT_TRUE(WritePdfReport(dir.File("r.pdf"), in).ok());
+  ASSERT_TRUE(WritePdfReport(dir.File("r.pdf"), InputOf("p", report, c)).ok());
   const std::string info = Shell("pdfinfo '" + dir.File("r.pdf") + "'");
   EXPECT_GE(Pages(info), 2) << info;
   std::istringstream text(Shell("pdftotext -raw '" + dir.File("r.pdf") + "' -"));
@@ -319,13 +311,8 @@ TEST(PdfReport, SectionsGetPagesOfPlots) {
     }
     report.sections.push_back(s);
   }
-  PdfReportInput in;
-  in.part_id = "p";
-  in.report = &report;
-  in.points_in_part = &c.points;
-  in.deviation_mm = &c.deviation;
   TempDir dir;
-  ASSERT_TRUE(WritePdfReport(dir.File("r.pdf"), in).ok());
+  ASSERT_TRUE(WritePdfReport(dir.File("r.pdf"), InputOf("p", report, c)).ok());
   EXPECT_EQ(Pages(Shell("pdfinfo '" + dir.File("r.pdf") + "'")), 3) << "page 1, then 6 + 1";
   const std::string text = Shell("pdftotext -raw '" + dir.File("r.pdf") + "' -");
   for (int k = 0; k < 7; ++k) EXPECT_NE(text.find("cut-" + std::to_string(k)), std::string::npos);
